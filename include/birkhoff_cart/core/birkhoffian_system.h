@@ -1,0 +1,66 @@
+// Birkhoffian systems on z ∈ R^{2n} (docs/birkhoffian.md, sign convention eq. (B.1)):
+//
+//   K(z,t) ż = ∇B(z,t) + ∂R/∂t(z,t) + Λ(z,t),      K_ij = ∂R_j/∂z_i − ∂R_i/∂z_j,
+//
+// with Birkhoff functions R, Birkhoffian B, structure matrix K and an explicit non-Birkhoffian
+// generalized force Λ (nonholonomic terms, applied loads). Passive coordinates y (reconstructed
+// coordinates, accumulated work) follow ẏ = g(z, t) and never feed back.
+//
+// A system type `System` models this concept (static polymorphism, as Boost.Odeint's systems) by
+// providing, with Vector<S> = Eigen::Matrix<S, kDimension, 1>:
+//
+//   static constexpr int kDimension;          // 2n
+//   static constexpr int kPassiveDimension;   // dim y (may be 0)
+//   template <class S> Vector<S>  birkhoff_functions(const Vector<S>& z, const S& t) const;   // R
+//   template <class S> S          birkhoffian(const Vector<S>& z, const S& t) const;          // B
+//   template <class S> Matrix<S>  structure_matrix(const Vector<S>& z, const S& t) const;     // K, analytic
+//   template <class S> Vector<S>  birkhoffian_gradient(const Vector<S>& z, const S& t) const; // ∇B, analytic
+//   template <class S> Vector<S>  birkhoff_functions_time_derivative(const Vector<S>& z, const S& t) const; // ∂R/∂t
+//   template <class S> Vector<S>  non_birkhoffian_force(const Vector<S>& z, const S& t) const; // Λ (zero
+//                                                                   // when non_birkhoffian_force_enabled() is false)
+//   bool non_birkhoffian_force_enabled() const;
+//   // A Darboux chart w = D(z, t) = (Q, P) with D_zᵀ K₀ D_z = K(z, t), K₀ = [[0, −I], [I, 0]], in
+//   // which the Birkhoffian part is Hamiltonian; the generalized symplectic schemes work in it.
+//   template <class S> Vector<S>  to_darboux(const Vector<S>& z, const S& t) const;
+//   template <class S> Vector<S>  from_darboux(const Vector<S>& w, const S& t) const;
+//   template <class S> Vector<S>  darboux_rates(const Vector<S>& w, const S& t) const;        // ẇ, analytic
+//   template <class S> PassiveVector<S> passive_rates(const Vector<S>& z, const S& t) const;  // g(z, t)
+//
+// The analytic members (K, ∇B, ∂R/∂t, ẇ) are what the integrators use; tests check each against
+// automatic differentiation of R and B (test/unit/birkhoffian_system_test.cpp).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/LU>
+
+namespace birkhoff_cart {
+
+template <class System, class S>
+using StateVector = Eigen::Matrix<S, System::kDimension, 1>;
+template <class System, class S>
+using StructureMatrix = Eigen::Matrix<S, System::kDimension, System::kDimension>;
+template <class System, class S>
+using PassiveVector = Eigen::Matrix<S, System::kPassiveDimension, 1>;
+
+/// K₀ = [[0, −I], [I, 0]]: the structure matrix of R = (p, 0), i.e. of canonical coordinates
+/// z = (q, p) in our sign convention (docs eq. (B.2)).
+template <int Dimension>
+Eigen::Matrix<double, Dimension, Dimension> canonical_structure() {
+  constexpr int n = Dimension / 2;
+  Eigen::Matrix<double, Dimension, Dimension> k = Eigen::Matrix<double, Dimension, Dimension>::Zero();
+  k.template block<n, n>(0, n) = -Eigen::Matrix<double, n, n>::Identity();
+  k.template block<n, n>(n, 0) = Eigen::Matrix<double, n, n>::Identity();
+  return k;
+}
+
+/// ż = K(z,t)⁻¹ (∇B + ∂R/∂t + Λ): Birkhoff's equations solved for the rates (docs eq. (B.1)).
+template <class System, class S>
+StateVector<System, S> birkhoffian_rates(const System& system, const StateVector<System, S>& z, const S& t) {
+  const StructureMatrix<System, S> k = system.structure_matrix(z, t);
+  const StateVector<System, S> right_hand_side = system.birkhoffian_gradient(z, t) +
+                                                 system.birkhoff_functions_time_derivative(z, t) +
+                                                 system.non_birkhoffian_force(z, t);
+  return k.partialPivLu().solve(right_hand_side);
+}
+
+}  // namespace birkhoff_cart

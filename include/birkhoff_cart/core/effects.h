@@ -1,0 +1,92 @@
+// Loads on the cart as composable effects. A scene enables effects by name; only enabled effects
+// exist in the EffectSet, so a disabled effect is never evaluated and costs nothing.
+// Generalized forces (Q1 [N], Q2 [N·m]) follow docs/derivation.md §4.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "birkhoff_cart/core/autodiff.h"
+#include "birkhoff_cart/core/cart_model.h"
+
+namespace birkhoff_cart {
+
+/// Where an effect reads the state: time and the reduced velocity state.
+struct EffectInput {
+  double time = 0.0;            ///< t [s]
+  double steering_angle = 0.0;  ///< χ [rad]
+  double forward_speed = 0.0;   ///< ω1 [m/s]
+  double steering_rate = 0.0;   ///< ω2 [rad/s]
+};
+
+/// Generalized force and its analytic Jacobian (used by Newton's method and by AD).
+struct GeneralizedForce {
+  Eigen::Vector2d force = Eigen::Vector2d::Zero();                ///< (Q1 [N], Q2 [N·m])
+  Eigen::Matrix<double, 2, 3> jacobian = Eigen::Matrix<double, 2, 3>::Zero();  ///< ∂Q/∂(χ, ω1, ω2)
+};
+
+/// A commanded value (a torque) written by the outside world (the ROS node) and read by an
+/// effect whose source is `command`: zero-order hold until the next write.
+struct CommandInput {
+  double value = 0.0;  ///< [N·m]
+};
+
+/// One load. Implementations live in src/core/effects/.
+class Effect {
+ public:
+  virtual ~Effect() = default;
+  /// The scene name of the effect (steering_torque, drive_torque, rolling_resistance, ...).
+  virtual const std::string& name() const = 0;
+  /// Adds this effect's Q and ∂Q/∂(χ, ω1, ω2) to `total`.
+  virtual void add_to(const EffectInput& input, GeneralizedForce& total) const = 0;
+};
+
+/// The enabled effects of a scene.
+class EffectSet {
+ public:
+  void add(std::unique_ptr<Effect> effect);
+  bool empty() const { return effects_.empty(); }
+  std::size_t size() const { return effects_.size(); }
+  const std::vector<std::unique_ptr<Effect>>& effects() const { return effects_; }
+
+  /// Sum of all enabled effects (zero for the free cart).
+  GeneralizedForce evaluate(const EffectInput& input) const;
+
+  /// Q as scalars of type S: plain values for double, values with derivatives propagated through
+  /// the analytic Jacobian for AD scalars (t is never differentiated).
+  template <class S>
+  Vector2<S> generalized_force(double time, const S& steering_angle, const Vector2<S>& quasi_velocity) const {
+    Vector2<S> result;
+    if (effects_.empty()) {
+      result.setConstant(S(0.0) * steering_angle);
+      return result;
+    }
+    EffectInput input;
+    input.time = time;
+    input.steering_angle = value_of(steering_angle);
+    input.forward_speed = value_of(quasi_velocity(0));
+    input.steering_rate = value_of(quasi_velocity(1));
+    const GeneralizedForce total = evaluate(input);
+    const S inputs[3] = {steering_angle, quasi_velocity(0), quasi_velocity(1)};
+    for (int row = 0; row < 2; ++row) {
+      const double partials[3] = {total.jacobian(row, 0), total.jacobian(row, 1), total.jacobian(row, 2)};
+      result(row) = chain(total.force(row), partials, inputs, 3);
+    }
+    return result;
+  }
+
+  /// The command inputs of effects whose source is `command` (nullptr when none).
+  std::shared_ptr<CommandInput> steering_command() const { return steering_command_; }
+  std::shared_ptr<CommandInput> drive_command() const { return drive_command_; }
+  void set_steering_command_input(std::shared_ptr<CommandInput> input) { steering_command_ = std::move(input); }
+  void set_drive_command_input(std::shared_ptr<CommandInput> input) { drive_command_ = std::move(input); }
+
+ private:
+  std::vector<std::unique_ptr<Effect>> effects_;
+  std::shared_ptr<CommandInput> steering_command_;
+  std::shared_ptr<CommandInput> drive_command_;
+};
+
+}  // namespace birkhoff_cart

@@ -1,0 +1,45 @@
+// The type-erased integrator the simulation uses, and the registry that makes one by name.
+#pragma once
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "birkhoff_cart/core/cart_model.h"
+#include "birkhoff_cart/core/diagnostics.h"
+#include "birkhoff_cart/core/effects.h"
+#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/state.h"
+
+namespace birkhoff_cart {
+
+/// A step that could not be taken (Newton did not converge, non-finite value, singular matrix).
+class StepError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Advances a CartState by one step of the cart's Birkhoffian system (rep (a) or (b)).
+class CartStepper {
+ public:
+  virtual ~CartStepper() = default;
+  virtual const std::string& name() const = 0;
+  /// Order of accuracy (2 or 4; dopri5 reports 5).
+  virtual int order() const = 0;
+  /// Time-symmetric (self-adjoint) method?
+  virtual bool symmetric() const = 0;
+  /// Advances `state` (time included) by h [s]; adds its work to `statistics`. Throws StepError
+  /// and leaves `state` untouched on failure.
+  virtual void step(CartState& state, double step_size, StepStatistics& statistics) = 0;
+};
+
+/// Registered names: birkhoff2, birkhoff4, rk2, rk4, dopri5, midpoint.
+std::vector<std::string> integrator_names();
+
+/// Makes the named integrator for `model` and `effects` (both must outlive it). Throws
+/// std::invalid_argument for an unknown name (listing the known ones) or bad settings.
+std::unique_ptr<CartStepper> make_cart_stepper(const IntegratorSettings& settings, const CartModel& model,
+                                               const EffectSet& effects);
+
+}  // namespace birkhoff_cart

@@ -1,0 +1,71 @@
+// A running scene: the constant model and effects, the chosen integrator, the mutable state and
+// its diagnostics. The time loop belongs to the caller (CLI, node, benchmark): step() advances
+// exactly one step of size h. Failures are transactional: a step that throws leaves the state
+// exactly as it was.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "birkhoff_cart/core/cart_model.h"
+#include "birkhoff_cart/core/diagnostics.h"
+#include "birkhoff_cart/core/effects.h"
+#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/state.h"
+
+namespace birkhoff_cart {
+
+class Simulation {
+ public:
+  /// Builds model, effects and integrator from a validated scene. Throws std::invalid_argument
+  /// naming the problem (unknown integrator, step size ≤ 0, degenerate mass matrix, ...).
+  explicit Simulation(const Scene& scene);
+  ~Simulation();
+
+  const Scene& scene() const { return scene_; }
+  const CartModel& model() const { return model_; }
+  const EffectSet& effects() const { return effects_; }
+  const CartState& state() const { return state_; }
+  /// The scene's end time t0 + duration [s].
+  double end_time() const;
+  double step_size() const { return scene_.integrator.step_size; }
+  const std::string& integrator_name() const { return scene_.integrator.name; }
+
+  /// Advances one step of size h. The state's time is t0 + n h exactly (no accumulated round-off).
+  /// Throws StepError (state unchanged) when the step fails (Newton did not converge, a
+  /// non-finite value appeared, the mass matrix became singular).
+  void step();
+  /// Steps while time + h/2 ≤ `time`.
+  void advance_to(double time);
+  /// Back to the scene's initial state, counters and reference included.
+  void reset();
+
+  /// Command inputs (zero-order hold). Throw std::invalid_argument for a non-finite torque and
+  /// std::logic_error when the scene's effect does not take commands.
+  bool accepts_steering_command() const;
+  bool accepts_drive_command() const;
+  void set_steering_command(double torque);  ///< [N·m]
+  void set_drive_command(double torque);     ///< [N·m]
+  double steering_command() const;           ///< the torque in force [N·m]
+  double drive_command() const;              ///< the torque in force [N·m]
+
+  /// Invariants and errors of the current state (reference error only when the scene asks).
+  Diagnostics diagnostics() const;
+  const StepStatistics& statistics() const { return statistics_; }
+
+ private:
+  Scene scene_;
+  CartModel model_;
+  EffectSet effects_;
+  std::unique_ptr<CartStepper> stepper_;
+  CartState state_;
+  std::uint64_t steps_taken_ = 0;
+  StepStatistics statistics_;
+  double initial_energy_ = 0.0;
+  double initial_steering_momentum_ = 0.0;
+  std::unique_ptr<class ReferenceSolution> reference_;
+};
+
+}  // namespace birkhoff_cart
