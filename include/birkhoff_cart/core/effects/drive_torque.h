@@ -1,0 +1,25 @@
+// Drive torque T(t), the total on the rear axle: Q = (T cos χ / r1, 0)   (docs/derivation.md eq. (4.2)).
+#pragma once
+
+#include <string>
+
+#include "birkhoff_cart/core/effects.h"
+#include "birkhoff_cart/core/effects/torque_source.h"
+
+namespace birkhoff_cart {
+
+class DriveTorque : public Effect {
+ public:
+  /// rear_wheel_radius r1 [m], > 0.
+  DriveTorque(TorqueSource source, double rear_wheel_radius);
+  const std::string& name() const override;
+  /// Q1 += T cos χ / r1;  ∂Q1/∂χ += −T sin χ / r1.
+  void add_to(const EffectInput& input, GeneralizedForce& total) const override;
+  const TorqueSource& source() const { return source_; }
+
+ private:
+  TorqueSource source_;
+  double rear_wheel_radius_;  ///< r1 [m]
+};
+
+}  // namespace birkhoff_cart

@@ -1,0 +1,22 @@
+// Torsion spring centring the steering hinge: Q = (0, −k_s χ)   (docs/derivation.md eq. (4.6)).
+#pragma once
+
+#include <string>
+
+#include "birkhoff_cart/core/effects.h"
+
+namespace birkhoff_cart {
+
+class SteeringStiffness : public Effect {
+ public:
+  /// coefficient k_s [N·m/rad] ≥ 0.
+  explicit SteeringStiffness(double coefficient);
+  const std::string& name() const override;
+  /// Q2 += −k_s χ;  ∂Q2/∂χ += −k_s.
+  void add_to(const EffectInput& input, GeneralizedForce& total) const override;
+
+ private:
+  double coefficient_;  ///< k_s [N·m/rad]
+};
+
+}  // namespace birkhoff_cart

@@ -1,0 +1,32 @@
+// Where a torque effect takes its torque from: a time profile or a shared command input.
+#pragma once
+
+#include <memory>
+
+#include "birkhoff_cart/core/effects.h"
+#include "birkhoff_cart/core/scene.h"
+
+namespace birkhoff_cart {
+
+class TorqueSource {
+ public:
+  /// With a non-null `command` the torque is command->value (zero-order hold); else profile.at(t).
+  explicit TorqueSource(const TorqueProfile& profile, std::shared_ptr<CommandInput> command = nullptr)
+      : profile_(profile), command_(std::move(command)) {}
+
+  /// The torque at time t [N·m].
+  double at(double time) const { return command_ ? command_->value : profile_.at(time); }
+
+  const TorqueProfile& profile() const { return profile_; }
+  const std::shared_ptr<CommandInput>& command() const { return command_; }
+
+ private:
+  TorqueProfile profile_;
+  std::shared_ptr<CommandInput> command_;
+};
+
+/// Throws std::invalid_argument naming `effect_name` and the profile field that is unusable
+/// (non-finite value, negative frequency, width ≤ 0, ramp end before start).
+void validate_torque_profile(const std::string& effect_name, const TorqueProfile& profile);
+
+}  // namespace birkhoff_cart
