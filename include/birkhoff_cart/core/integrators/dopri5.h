@@ -1,0 +1,112 @@
+// Adaptive Dormand–Prince 5(4) ("dopri5") from Boost.Odeint, used as a tolerance-controlled
+// reference peer. Scheme: the embedded explicit Runge–Kutta pair of Dormand & Prince (1980),
+// 7 stages, FSAL, 5th-order solution with a 4th-order error estimate (Hairer–Nørsett–Wanner I,
+// Table II.5.2); step-size control by odeint's controlled_runge_kutta with the error checker
+//
+//   err = max_i |x̂_i − x_i| / (ε_abs + ε_rel (|x_i| + h |ẋ_i|)),   accept if err ≤ 1,
+//
+// with ε_abs = ε_rel = IntegratorSettings::tolerance. It integrates the joint system
+// (ż, ẏ) = (K(z,t)⁻¹(∇B + ∂R/∂t + Λ), g(z, t)) over each simulator step [t, t + h] with
+// odeint's integrate_adaptive (the last internal step is shortened to land on t + h exactly).
+//
+// Determinism: the internal step-size guess is carried from one simulator step to the next (the
+// last internal step the controller chose freely, i.e. not shortened to land on t + h); a fresh
+// odeint stepper is made for every simulator step, so its first-same-as-last cache never holds a
+// rate from before a command change or a reset. Same inputs ⇒ bit-identical outputs.
+// Double precision only (odeint's controller is not meant to be differentiated).
+#pragma once
+
+#include <array>
+#include <boost/numeric/odeint.hpp>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <type_traits>
+
+#include "birkhoff_cart/core/birkhoffian_system.h"
+#include "birkhoff_cart/core/diagnostics.h"
+#include "birkhoff_cart/core/integrators/cart_stepper.h"
+
+namespace birkhoff_cart {
+
+class DormandPrince5 {
+ public:
+  static constexpr int kOrder = 5;
+  static constexpr bool kSymmetric = false;
+  static const char* name() { return "dopri5"; }
+
+  /// `tolerance`: absolute and relative error tolerance per internal step [-], > 0.
+  explicit DormandPrince5(double tolerance = 1e-10) : tolerance_(tolerance) {
+    if (!(tolerance > 0.0) || !std::isfinite(tolerance)) {
+      std::ostringstream message;
+      message << "dopri5 tolerance must be finite and > 0, got " << tolerance;
+      throw std::invalid_argument(message.str());
+    }
+  }
+
+  double tolerance() const { return tolerance_; }
+  /// The internal step-size guess for the next simulator step [s] (0: none yet, use h).
+  double step_size_guess() const { return step_size_guess_; }
+  /// Forget the step-size guess (the next step starts from h, as after construction).
+  void reset() { step_size_guess_ = 0.0; }
+
+  template <class System, class S>
+  void step(const System& system, StateVector<System, S>& z, PassiveVector<System, S>& y, double t, double h,
+            StepStatistics& statistics) const {
+    static_assert(std::is_same<S, double>::value, "dopri5 integrates in double precision only");
+    constexpr int n = System::kDimension;
+    constexpr int m = System::kPassiveDimension;
+    using Joint = std::array<double, n + m>;
+    namespace odeint = boost::numeric::odeint;
+
+    Joint x;
+    for (int i = 0; i < n; ++i) x[i] = z(i);
+    for (int i = 0; i < m; ++i) x[n + i] = y(i);
+
+    std::uint64_t evaluations = 0;
+    auto rates = [&system, &evaluations](const Joint& state, Joint& state_rate, double time) {
+      StateVector<System, double> z_now;
+      for (int i = 0; i < n; ++i) z_now(i) = state[i];
+      const StateVector<System, double> z_rate = birkhoffian_rates(system, z_now, time);  // ż = f(z, t)
+      const PassiveVector<System, double> y_rate = system.passive_rates(z_now, time);     // ẏ = g(z, t)
+      for (int i = 0; i < n; ++i) state_rate[i] = z_rate(i);
+      for (int i = 0; i < m; ++i) state_rate[n + i] = y_rate(i);
+      ++evaluations;
+    };
+
+    // Internal step times, to carry the controller's last free choice to the next simulator step.
+    double previous_time = t;
+    double last_free_step = 0.0;
+    const double end_time = t + h;
+    auto observer = [&](const Joint&, double time) {
+      const double taken = time - previous_time;
+      if (time != t && time != end_time) last_free_step = taken;  // not shortened to hit t + h
+      previous_time = time;
+    };
+
+    auto controlled = odeint::make_controlled(tolerance_, tolerance_, odeint::runge_kutta_dopri5<Joint>());
+    const double first_guess = step_size_guess_ > 0.0 ? step_size_guess_ : h;
+    try {
+      // x(t + h) ← adaptive dopri5 steps over [t, t + h]
+      odeint::integrate_adaptive(controlled, rates, x, t, end_time, first_guess, observer);
+    } catch (const std::overflow_error& error) {  // odeint: too many rejected steps
+      statistics.rhs_evaluations += evaluations;
+      std::ostringstream message;
+      message << "dopri5 failed at t = " << t << " s: " << error.what();
+      throw StepError(message.str());
+    }
+    statistics.rhs_evaluations += evaluations;
+
+    for (int i = 0; i < n; ++i) z(i) = x[i];
+    for (int i = 0; i < m; ++i) y(i) = x[n + i];
+    if (last_free_step > 0.0) step_size_guess_ = last_free_step;
+    else if (step_size_guess_ <= 0.0) step_size_guess_ = h;
+  }
+
+ private:
+  double tolerance_;
+  mutable double step_size_guess_ = 0.0;  ///< [s]; mutable: step() is const in the stepper concept
+};
+
+}  // namespace birkhoff_cart
