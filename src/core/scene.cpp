@@ -1,0 +1,196 @@
+// load_scene: YAML scene file → validated Scene. Schema: docs/scenes.md.
+#include "birkhoff_cart/core/scene.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+
+#include "birkhoff_cart/core/cart_model.h"
+#include "birkhoff_cart/core/effect_library.h"
+#include "scene_reader.h"
+
+namespace birkhoff_cart {
+namespace {
+
+using scene_detail::Range;
+using scene_detail::SceneReader;
+
+/// Mirrors the integrator registry (integrator_names() in cart_stepper.h).
+const std::vector<std::string>& known_integrators() {
+  static const std::vector<std::string> kNames = {"birkhoff2", "birkhoff4", "rk2", "rk4", "dopri5", "midpoint"};
+  return kNames;
+}
+
+std::string one_line(std::string text) {
+  for (char& character : text) {
+    if (character == '\n' || character == '\r') character = ' ';
+  }
+  return text;
+}
+
+std::string file_stem(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
+  const std::size_t dot = name.find_last_of('.');
+  return dot == std::string::npos ? name : name.substr(0, dot);
+}
+
+CartParameters read_cart(const SceneReader& reader, const YAML::Node& node) {
+  CartParameters cart;
+  const std::pair<const char*, double*> fields[] = {
+      {"wheelbase", &cart.wheelbase},
+      {"rear_half_track", &cart.rear_half_track},
+      {"front_half_track", &cart.front_half_track},
+      {"rear_wheel_radius", &cart.rear_wheel_radius},
+      {"front_wheel_radius", &cart.front_wheel_radius},
+      {"rear_body_mass", &cart.rear_body_mass},
+      {"rear_body_yaw_inertia", &cart.rear_body_yaw_inertia},
+      {"front_axle_mass", &cart.front_axle_mass},
+      {"front_axle_yaw_inertia", &cart.front_axle_yaw_inertia},
+      {"rear_wheel_mass", &cart.rear_wheel_mass},
+      {"rear_wheel_spin_inertia", &cart.rear_wheel_spin_inertia},
+      {"rear_wheel_yaw_inertia", &cart.rear_wheel_yaw_inertia},
+      {"front_wheel_mass", &cart.front_wheel_mass},
+      {"front_wheel_spin_inertia", &cart.front_wheel_spin_inertia},
+      {"front_wheel_yaw_inertia", &cart.front_wheel_yaw_inertia},
+      {"gravity", &cart.gravity},
+  };
+  std::vector<std::string> allowed;
+  for (const auto& field : fields) allowed.push_back(field.first);
+  reader.require_map(node, "cart", allowed);
+  for (const auto& [name, destination] : fields) {
+    *destination = reader.required_number(node, "cart", name, Range::kPositive);
+  }
+  return cart;
+}
+
+CartState read_initial_state(const SceneReader& reader, const YAML::Node& node) {
+  const std::string key = "initial_state";
+  reader.require_map(node, key,
+                     {"time", "x", "y", "heading", "steering_angle", "wheel_spin_angles", "arc_length",
+                      "forward_speed", "steering_rate"});
+  CartState state;
+  state.time = reader.optional_number(node, key, "time", Range::kFinite, 0.0);
+  state.x = reader.optional_number(node, key, "x", Range::kFinite, 0.0);
+  state.y = reader.optional_number(node, key, "y", Range::kFinite, 0.0);
+  state.heading = reader.optional_number(node, key, "heading", Range::kFinite, 0.0);
+  state.steering_angle = reader.required_number(node, key, "steering_angle", Range::kFinite);
+  state.arc_length = reader.optional_number(node, key, "arc_length", Range::kFinite, 0.0);
+  state.forward_speed = reader.required_number(node, key, "forward_speed", Range::kFinite);
+  state.steering_rate = reader.required_number(node, key, "steering_rate", Range::kFinite);
+  if (reader.has(node, "wheel_spin_angles")) {
+    const std::string spin_key = SceneReader::join(key, "wheel_spin_angles");
+    const YAML::Node spins = reader.required(node, key, "wheel_spin_angles");
+    if (!spins.IsSequence() || spins.size() != 4) reader.fail(spin_key, "must be a list of 4 angles [rad]");
+    for (std::size_t wheel = 0; wheel < 4; ++wheel) {
+      state.wheel_spin_angle[wheel] =
+          reader.number(spins[wheel], spin_key + "[" + std::to_string(wheel) + "]", Range::kFinite);
+    }
+  }
+  return state;
+}
+
+IntegratorSettings read_integrator(const SceneReader& reader, const YAML::Node& node, const std::string& key) {
+  reader.require_map(node, key,
+                     {"name", "step_size", "tolerance", "birkhoffian_form", "max_newton_iterations",
+                      "newton_tolerance"});
+  IntegratorSettings settings;
+  settings.name = reader.choice(node, key, "name", known_integrators());
+  settings.step_size = reader.required_number(node, key, "step_size", Range::kPositive);
+  settings.tolerance = reader.optional_number(node, key, "tolerance", Range::kPositive, settings.tolerance);
+  if (reader.has(node, "birkhoffian_form")) {
+    settings.birkhoffian_form = reader.choice(node, key, "birkhoffian_form", {"autonomous", "paper"});
+  }
+  settings.max_newton_iterations =
+      reader.optional_positive_integer(node, key, "max_newton_iterations", settings.max_newton_iterations);
+  settings.newton_tolerance =
+      reader.optional_number(node, key, "newton_tolerance", Range::kPositive, settings.newton_tolerance);
+  return settings;
+}
+
+ReferenceSettings read_reference(const SceneReader& reader, const YAML::Node& node, bool paper_special_case) {
+  ReferenceSettings reference;
+  if (!node || node.IsNull()) return reference;
+  reader.require_map(node, "reference", {"kind", "integrator"});
+  const std::string kind = reader.choice(node, "reference", "kind", {"none", "paper_analytic", "shadow_run"});
+  if (kind == "shadow_run") {
+    reference.kind = ReferenceSettings::Kind::kShadowRun;
+    reference.shadow = read_integrator(reader, reader.required(node, "reference", "integrator"), "reference.integrator");
+  } else {
+    if (reader.has(node, "integrator")) reader.fail("reference.integrator", "is only for kind 'shadow_run'");
+    if (kind == "paper_analytic") {
+      if (!paper_special_case) {
+        reader.fail("reference.kind", "'paper_analytic' needs 'paper_special_case: true' (the closed form of eq. (3.9))");
+      }
+      reference.kind = ReferenceSettings::Kind::kPaperAnalytic;
+    }
+  }
+  return reference;
+}
+
+Scene read_scene(const SceneReader& reader, const YAML::Node& root, const std::string& path) {
+  if (!root || root.IsNull()) reader.fail("(document)", "is empty");
+  reader.require_map(root, "",
+                     {"description", "cart", "paper_special_case", "initial_state", "duration", "integrator",
+                      "output_rate", "effects", "reference"});
+  Scene scene;
+  scene.name = file_stem(path);
+  scene.source_path = path;
+  scene.description = reader.text(reader.required(root, "", "description"), "description");
+  scene.cart = read_cart(reader, reader.required(root, "", "cart"));
+  scene.paper_special_case = reader.optional_boolean(root, "", "paper_special_case", false);
+  scene.initial_state = read_initial_state(reader, reader.required(root, "", "initial_state"));
+  scene.duration = reader.required_number(root, "", "duration", Range::kPositive);
+  scene.integrator = read_integrator(reader, reader.required(root, "", "integrator"), "integrator");
+  if (scene.integrator.step_size > scene.duration) {
+    reader.fail("integrator.step_size", "must not exceed the duration");
+  }
+  scene.output_rate = reader.optional_number(root, "", "output_rate", Range::kPositive, scene.output_rate);
+  scene.effects = scene_detail::read_effects(reader, root["effects"]);
+  scene.reference = read_reference(reader, root["reference"], scene.paper_special_case);
+
+  // The cart must give a usable mass matrix (only the declared paper case may be singular).
+  if (scene.paper_special_case && scene.cart.wheelbase != 1.0) {
+    reader.fail("cart.wheelbase", "must be 1 with 'paper_special_case: true' (eq. (3.9) sets l = 1)");
+  }
+  try {
+    const CartModel model(scene.cart, scene.paper_special_case ? InertiaModel::kPaperSpecialCase
+                                                               : InertiaModel::kPhysical);
+    build_effects(scene.effects, model);  // the effects accept their coefficients
+  } catch (const SceneError&) {
+    throw;
+  } catch (const std::invalid_argument& error) {
+    const std::string message = error.what();
+    reader.fail(message.rfind("effect", 0) == 0 ? "effects" : "cart", one_line(message));
+  }
+  return scene;
+}
+
+}  // namespace
+
+SceneError::SceneError(const std::string& file, const std::string& key, const std::string& problem)
+    : std::runtime_error("scene " + file + ": key '" + key + "': " + one_line(problem)), file_(file), key_(key) {}
+
+Scene load_scene(const std::string& path) {
+  const SceneReader reader(path);
+  std::ifstream stream(path);
+  if (!stream) reader.fail("(file)", "cannot be opened for reading");
+  YAML::Node root;
+  try {
+    root = YAML::Load(stream);
+  } catch (const YAML::ParserException& error) {
+    reader.fail("(syntax)", "YAML syntax error at line " + std::to_string(error.mark.line + 1) + ", column " +
+                                std::to_string(error.mark.column + 1) + ": " + error.msg);
+  }
+  try {
+    return read_scene(reader, root, path);
+  } catch (const SceneError&) {
+    throw;
+  } catch (const YAML::Exception& error) {
+    reader.fail("(document)", one_line(error.what()));
+  }
+}
+
+}  // namespace birkhoff_cart
