@@ -1,0 +1,155 @@
+// The ROS wrapper around a core Simulation (robot_localization style: the core knows nothing of
+// ROS; this class only translates). Every private parameter is read once in load_parameters() and
+// documented in docs/ros_interface.md (meaning, unit, default).
+//
+// Time: the node steps the simulation in lockstep and publishes /clock itself (run with
+// /use_sim_time true); message stamps are the scene's time t (scene time t is ROS time t). The
+// first /clock is one step after the start (t0 + h), never 0. Fast mode runs as fast as possible
+// (or at ~real_time_factor); real-time mode is paced by the wall clock. Between steps the node
+// processes its callbacks, so commands take effect at deterministic scene times.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <ros/ros.h>
+#include <std_msgs/Float64.h>
+#include <std_srvs/Empty.h>
+#include <std_srvs/SetBool.h>
+#include <tf2_ros/transform_broadcaster.h>
+
+#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/ros/bag_recorder.h"
+#include "birkhoff_cart/ros/command_channel.h"
+#include "birkhoff_cart/ros/conversions.h"
+
+namespace birkhoff_cart {
+
+/// Every private parameter of cart_sim, with its default (docs/ros_interface.md).
+struct CartSimParameters {
+  std::string scene_path;                    ///< ~scene: scene YAML (required)
+  std::string integrator;                    ///< ~integrator: registry name; "" = the scene's
+  double step_size = 0.0;                    ///< ~step_size: h [s]; 0 = the scene's
+  double publish_rate = 100.0;               ///< ~publish_rate: [Hz of scene time]
+  bool fast = false;                         ///< ~fast: lockstep as fast as possible (true) or real time
+  double real_time_factor = 0.0;             ///< ~real_time_factor: [-]; 0 = unlimited (fast) / 1 (real time)
+  double duration = -1.0;                    ///< ~duration: [s]; < 0 = the scene's; 0 = until shutdown
+  double command_timeout = 0.5;              ///< ~command_timeout: watchdog silence [s of scene time]; 0 = off
+  double max_steering_torque = 100.0;        ///< ~max_steering_torque: clamp [N·m]
+  double max_drive_torque = 200.0;           ///< ~max_drive_torque: clamp [N·m]
+  std::string bag_path;                      ///< ~bag_path: record here; "" = no record
+  std::string bag_compression = "lz4";       ///< ~bag_compression: lz4, bz2 or none
+  std::string summary_path;                  ///< ~summary_path: also write the final summary here; "" = no file
+  ros_conversions::FrameNames frames;        ///< ~odom_frame, ~base_frame
+  bool publish_tf = true;                    ///< ~publish_tf: odom → base_link on /tf
+  bool publish_clock = true;                 ///< ~publish_clock: the node drives /clock
+  bool start_paused = false;                 ///< ~start_paused: wait for ~pause(false) before stepping
+  double diagnostic_period = 1.0;            ///< ~diagnostic_period: /diagnostics every [s of scene time]
+  double energy_residual_warn = 1e-4;        ///< ~energy_residual_warn: |T* − T*₀ − W| [J]
+  double energy_residual_error = 1e-1;       ///< ~energy_residual_error: [J]
+  double p2_residual_warn = 1e-8;            ///< ~p2_residual_warn: |p2 − p2₀ − I2| [N·m·s]
+  double p2_residual_error = 1e-5;           ///< ~p2_residual_error: [N·m·s]
+  double constraint_residual_warn = 1e-9;    ///< ~constraint_residual_warn: max |(15)| [m/s]
+  double constraint_residual_error = 1e-6;   ///< ~constraint_residual_error: [m/s]
+};
+
+/// Reads and validates every private parameter. Throws std::invalid_argument naming the first bad one.
+CartSimParameters load_parameters(const ros::NodeHandle& private_node);
+
+/// Something that prevents the node from starting (bad parameter, scene, integrator or bag).
+class NodeStartupError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Signal handling without roscpp's: SIGINT and SIGTERM request a clean shutdown (the node closes
+/// its bag before it exits). Call once after ros::init(..., NoSigintHandler).
+void install_shutdown_signal_handlers();
+/// True once SIGINT/SIGTERM arrived.
+bool shutdown_signal_received();
+
+class CartSimNode {
+ public:
+  /// Exit codes of run().
+  static constexpr int kExitFinished = 0;     ///< duration reached or shutdown requested
+  static constexpr int kExitStepFailure = 1;  ///< a StepError stopped the simulation
+  static constexpr int kExitRecordFailure = 3;///< the bag could not be written
+
+  /// Loads parameters and scene, builds the simulation, opens the bag, advertises. Throws
+  /// NodeStartupError with a message naming the problem.
+  CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node);
+  ~CartSimNode();
+
+  /// The time loop; returns one of the exit codes after closing the bag and printing the summary.
+  int run();
+
+  const Simulation& simulation() const { return *simulation_; }
+  const CartSimParameters& parameters() const { return parameters_; }
+
+ private:
+  void on_steering_torque(const std_msgs::Float64::ConstPtr& message);
+  void on_drive_torque(const std_msgs::Float64::ConstPtr& message);
+  void receive_command(CommandChannel& channel, const std::string& topic, const std_msgs::Float64& message);
+  bool on_reset(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
+  bool on_pause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
+
+  void restart_schedule();
+  void apply_watchdogs();
+  void publish_clock(double time);
+  void publish_instant();
+  void produce_diagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
+  /// Processes callbacks; waits up to `wall_timeout` [s] for one when > 0.
+  void process_callbacks(double wall_timeout);
+  void pace();
+  void write_summary(const std::string& outcome);
+  bool end_reached() const;
+
+  ros::NodeHandle node_;
+  ros::NodeHandle private_node_;
+  CartSimParameters parameters_;
+  std::unique_ptr<Simulation> simulation_;
+  std::optional<CommandChannel> steering_channel_;
+  std::optional<CommandChannel> drive_channel_;
+  std::unique_ptr<BagRecorder> recorder_;
+
+  ros::Publisher odometry_publisher_;
+  ros::Publisher joint_state_publisher_;
+  ros::Publisher integration_error_publisher_;
+  ros::Publisher clock_publisher_;
+  ros::Subscriber steering_subscriber_;
+  ros::Subscriber drive_subscriber_;
+  ros::ServiceServer reset_service_;
+  ros::ServiceServer pause_service_;
+  std::unique_ptr<tf2_ros::TransformBroadcaster> transform_broadcaster_;
+  std::unique_ptr<diagnostic_updater::Updater> diagnostic_updater_;
+
+  double end_time_ = 0.0;                 ///< scene time at which the run stops [s]; +inf = never
+  double publish_period_ = 0.01;          ///< [s]
+  double effective_real_time_factor_ = 0; ///< pacing; 0 = unlimited
+  std::uint64_t next_publish_index_ = 1;  ///< k of the next publish instant t0 + k/publish_rate
+  std::uint64_t next_diagnostic_index_ = 1;
+  bool clock_started_ = false;            ///< the first /clock (t0 + h) went out
+  bool paused_ = false;
+  ros::Time last_transform_stamp_;        ///< never the same tf stamp twice
+  std::optional<std::string> step_failure_;
+  std::optional<std::string> record_failure_;
+
+  // Work measurement (wall clock) for integration_error, diagnostics and the summary.
+  ros::WallTime run_start_wall_;
+  double stepping_wall_time_ = 0.0;           ///< wall time spent inside step() since the start [s]
+  double period_stepping_wall_time_ = 0.0;    ///< ... since the last publish instant [s]
+  std::uint64_t period_steps_ = 0;
+  double last_wall_time_per_step_ = 0.0;      ///< [s]
+  std::uint64_t total_steps_ = 0;             ///< steps over the whole run, resets included
+  double simulated_time_ = 0.0;               ///< scene time advanced over the whole run [s]
+  ros::WallTime pace_anchor_wall_;
+  double pace_anchor_time_ = 0.0;
+  std::uint64_t published_instants_ = 0;
+  std::uint64_t diagnostics_rejections_seen_ = 0;
+};
+
+}  // namespace birkhoff_cart

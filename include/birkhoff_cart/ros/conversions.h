@@ -1,0 +1,66 @@
+// Pure translations from the core's state and diagnostics to ROS messages. No publishing, no
+// physics: rates and positions come from the core (CartModel, Simulation::diagnostics()).
+// Frames follow REP-105: odom → base_link, base_link at the rear-axle midpoint A on the ground.
+#pragma once
+
+#include <array>
+#include <string>
+
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/Odometry.h>
+#include <ros/time.h>
+#include <sensor_msgs/JointState.h>
+
+#include "birkhoff_cart/IntegrationError.h"
+#include "birkhoff_cart/core/cart_model.h"
+#include "birkhoff_cart/core/diagnostics.h"
+#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/state.h"
+
+namespace birkhoff_cart {
+namespace ros_conversions {
+
+/// Joint names of urdf/cart.urdf, in the order of JointState messages: χ, φ1, φ2, φ3, φ4.
+const std::array<std::string, 5>& joint_names();
+
+/// Frame names of the published odometry and transform.
+struct FrameNames {
+  std::string odom = "odom";            ///< fixed frame
+  std::string base_link = "base_link";  ///< rear-axle midpoint A on the ground
+};
+
+/// The torques the actuators apply at one instant (joint efforts).
+struct ActuatorEfforts {
+  double steering_torque = 0.0;  ///< τ on steering_joint [N·m]
+  double drive_torque = 0.0;     ///< T, total on the rear axle, split equally on φ1, φ2 [N·m]
+};
+
+/// Scene time t [s] as ROS time (scene time t is ROS time t). Throws std::invalid_argument for a
+/// negative or non-finite time.
+ros::Time to_ros_time(double time);
+
+/// nav_msgs/Odometry of base_link (A, heading θ) in odom; twist in base_link:
+/// linear.x = v_A = ω1 cos χ, angular.z = θ̇ = ω1 sin χ / l (docs eqs. (2.3)).
+nav_msgs::Odometry to_odometry(const CartState& state, const CartModel& model, const FrameNames& frames);
+
+/// odom → base_link transform of the state (same pose as to_odometry).
+geometry_msgs::TransformStamped to_transform(const CartState& state, const CartModel& model,
+                                             const FrameNames& frames);
+
+/// Joint positions (χ, φ1..φ4) [rad], velocities (ω2, φ̇1..φ̇4) [rad/s] and actuator efforts
+/// (τ, T/2, T/2, 0, 0) [N·m].
+sensor_msgs::JointState to_joint_state(const CartState& state, const CartModel& model,
+                                       const ActuatorEfforts& efforts);
+
+/// The torques the scene's steering_torque and drive_torque effects apply at the simulation's
+/// current time (the command in force for a command source, the profile otherwise; 0 without the
+/// effect).
+ActuatorEfforts actuator_efforts(const Simulation& simulation);
+
+/// The integration_error message of one published instant.
+IntegrationError to_integration_error(const CartState& state, const Diagnostics& diagnostics,
+                                      const StepStatistics& statistics, const std::string& integrator,
+                                      double step_size, double wall_time_per_step);
+
+}  // namespace ros_conversions
+}  // namespace birkhoff_cart
