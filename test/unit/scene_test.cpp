@@ -1,0 +1,362 @@
+// Scene files: every shipped scene loads and says what the scene table (docs/scenes.md) says;
+// malformed files are refused with a one-line SceneError naming the file and the key.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "birkhoff_cart/core/effect_library.h"
+#include "birkhoff_cart/core/scene.h"
+
+namespace birkhoff_cart {
+namespace {
+
+constexpr double kExact = 0.0;  // values read from a file must round-trip exactly [-]
+
+std::string scene_path(const std::string& name) {
+  return std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/" + name + ".yaml";
+}
+
+const EffectSpec* find_effect(const Scene& scene, const std::string& name) {
+  for (const EffectSpec& spec : scene.effects) {
+    if (spec.name == name) return &spec;
+  }
+  return nullptr;
+}
+
+void expect_default_cart(const CartParameters& cart, double wheelbase = 1.05) {
+  EXPECT_EQ(cart.wheelbase, wheelbase);
+  EXPECT_EQ(cart.rear_half_track, 0.55);
+  EXPECT_EQ(cart.front_half_track, 0.5);
+  EXPECT_EQ(cart.rear_wheel_radius, 0.14);
+  EXPECT_EQ(cart.front_wheel_radius, 0.13);
+  EXPECT_EQ(cart.rear_body_mass, 140.0);
+  EXPECT_EQ(cart.rear_body_yaw_inertia, 30.0);
+  EXPECT_EQ(cart.front_axle_mass, 12.0);
+  EXPECT_EQ(cart.front_axle_yaw_inertia, 1.0);
+  EXPECT_EQ(cart.rear_wheel_mass, 3.0);
+  EXPECT_EQ(cart.rear_wheel_spin_inertia, 0.03);
+  EXPECT_EQ(cart.rear_wheel_yaw_inertia, 0.025);
+  EXPECT_EQ(cart.front_wheel_mass, 2.2);
+  EXPECT_EQ(cart.front_wheel_spin_inertia, 0.019);
+  EXPECT_EQ(cart.front_wheel_yaw_inertia, 0.013);
+  EXPECT_EQ(cart.gravity, 9.81);
+}
+
+/// One row of the scene table: initial (χ, ω1, ω2), duration, enabled effect names.
+struct SceneRow {
+  std::string name;
+  double steering_angle;             // χ [rad]
+  double forward_speed;              // ω1 [m/s]
+  double steering_rate;              // ω2 [rad/s]
+  double duration;                   // [s]
+  std::vector<std::string> effects;  // in file order
+};
+
+class ShippedScene : public ::testing::TestWithParam<SceneRow> {};
+
+TEST_P(ShippedScene, LoadsAndMatchesTheTable) {
+  const SceneRow& row = GetParam();
+  const Scene scene = load_scene(scene_path(row.name));
+  EXPECT_EQ(scene.name, row.name);
+  EXPECT_FALSE(scene.description.empty());
+  EXPECT_EQ(scene.description.find('\n'), std::string::npos);
+  expect_default_cart(scene.cart);
+  EXPECT_FALSE(scene.paper_special_case);
+  const CartState& state = scene.initial_state;
+  EXPECT_EQ(state.time, 0.0);
+  EXPECT_EQ(state.x, 0.0);
+  EXPECT_EQ(state.y, 0.0);
+  EXPECT_EQ(state.heading, 0.0);
+  for (double spin : state.wheel_spin_angle) EXPECT_EQ(spin, 0.0);
+  EXPECT_EQ(state.arc_length, 0.0);
+  EXPECT_NEAR(state.steering_angle, row.steering_angle, kExact);
+  EXPECT_NEAR(state.forward_speed, row.forward_speed, kExact);
+  EXPECT_NEAR(state.steering_rate, row.steering_rate, kExact);
+  EXPECT_NEAR(scene.duration, row.duration, kExact);
+  EXPECT_EQ(scene.integrator.name, "birkhoff2");
+  EXPECT_EQ(scene.integrator.step_size, 1e-3);
+  EXPECT_EQ(scene.output_rate, 100.0);
+  ASSERT_EQ(scene.effects.size(), row.effects.size());
+  for (std::size_t i = 0; i < row.effects.size(); ++i) EXPECT_EQ(scene.effects[i].name, row.effects[i]);
+  // The effects build against the cart.
+  const CartModel model(scene.cart);
+  EXPECT_EQ(build_effects(scene.effects, model).size(), row.effects.size());
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Scenes, ShippedScene,
+    ::testing::Values(
+        SceneRow{"free_coast", 0.0, 3.0, 0.5, 6.0, {}},
+        SceneRow{"const_steer_torque", 0.0, 4.0, 0.0, 5.0, {"steering_torque"}},
+        SceneRow{"sine_steer_torque", 0.0, 5.0, 0.0, 6.0, {"steering_torque"}},
+        SceneRow{"drive_rr_drag", 0.0, 0.0, 0.0, 8.0, {"drive_torque", "rolling_resistance", "air_drag", "steering_torque"}},
+        SceneRow{"near_jackknife", 1.2, 2.0, 0.41456381575724666, 6.0, {}},
+        SceneRow{"jackknife_whirl", 1.2, 2.0, 1.2, 4.0, {}},
+        SceneRow{"reverse_jackknife", 0.0, -2.0, -0.05, 6.0, {}},
+        SceneRow{"stiff_hinge", 0.3, 3.0, 0.0, 4.0, {"steering_stiffness", "steering_damping"}},
+        SceneRow{"default", 0.0, 1.0, 0.0, 60.0,
+                 {"drive_torque", "rolling_resistance", "air_drag", "steering_torque", "steering_damping"}}),
+    [](const ::testing::TestParamInfo<SceneRow>& info) { return info.param.name; });
+
+TEST(ShippedScenes, EffectParametersMatchTheTable) {
+  const Scene constant = load_scene(scene_path("const_steer_torque"));
+  EXPECT_EQ(constant.effects[0].profile.kind, TorqueProfile::Kind::kConstant);
+  EXPECT_EQ(constant.effects[0].profile.value, 0.4);
+
+  const Scene sine = load_scene(scene_path("sine_steer_torque"));
+  EXPECT_EQ(sine.effects[0].profile.kind, TorqueProfile::Kind::kCosine);
+  EXPECT_EQ(sine.effects[0].profile.amplitude, 3.0);
+  EXPECT_EQ(sine.effects[0].profile.frequency, 0.5);
+  EXPECT_EQ(sine.effects[0].profile.phase, 0.0);
+
+  const Scene drive = load_scene(scene_path("drive_rr_drag"));
+  const EffectSpec* torque = find_effect(drive, "drive_torque");
+  ASSERT_NE(torque, nullptr);
+  EXPECT_EQ(torque->profile.kind, TorqueProfile::Kind::kSmoothSwitchOff);
+  EXPECT_EQ(torque->profile.initial, 60.0);
+  EXPECT_EQ(torque->profile.switch_off_time, 4.0);
+  EXPECT_EQ(torque->profile.width, 0.3);
+  EXPECT_EQ(find_effect(drive, "rolling_resistance")->coefficients.at("coefficient"), 0.015);
+  EXPECT_EQ(find_effect(drive, "rolling_resistance")->coefficients.at("speed_epsilon"), 0.05);
+  EXPECT_EQ(find_effect(drive, "air_drag")->coefficients.at("coefficient"), 0.3);
+  const TorqueProfile& steer = find_effect(drive, "steering_torque")->profile;
+  for (double time : {0.3, 1.0, 2.7}) {  // 1.5 sin(2π·0.25 t)
+    EXPECT_NEAR(steer.at(time), 1.5 * std::sin(2 * M_PI * 0.25 * time), 1e-14);
+  }
+
+  const Scene stiff = load_scene(scene_path("stiff_hinge"));
+  EXPECT_EQ(find_effect(stiff, "steering_stiffness")->coefficients.at("coefficient"), 2000.0);
+  EXPECT_EQ(find_effect(stiff, "steering_damping")->coefficients.at("coefficient"), 5.0);
+
+  const Scene slalom = load_scene(scene_path("default"));
+  EXPECT_EQ(slalom.reference.kind, ReferenceSettings::Kind::kShadowRun);
+  EXPECT_EQ(slalom.reference.shadow.name, "dopri5");
+  EXPECT_EQ(slalom.reference.shadow.tolerance, 1e-12);
+  EXPECT_EQ(load_scene(scene_path("free_coast")).reference.kind, ReferenceSettings::Kind::kNone);
+}
+
+TEST(ShippedScenes, PaperSpecialCase) {
+  const Scene paper = load_scene(scene_path("paper_special"));
+  EXPECT_TRUE(paper.paper_special_case);
+  expect_default_cart(paper.cart, 1.0);
+  EXPECT_EQ(paper.initial_state.time, M_PI / 2);
+  EXPECT_EQ(paper.initial_state.steering_angle, M_PI / 2);
+  EXPECT_EQ(paper.initial_state.arc_length, 1.0);
+  EXPECT_EQ(paper.initial_state.forward_speed, 1.0);
+  EXPECT_EQ(paper.initial_state.steering_rate, 1.0);
+  EXPECT_NEAR(paper.initial_state.time + paper.duration, 3.0, 1e-15);
+  EXPECT_TRUE(paper.effects.empty());
+  EXPECT_EQ(paper.reference.kind, ReferenceSettings::Kind::kPaperAnalytic);
+  EXPECT_EQ(paper.integrator.name, "birkhoff2");
+  EXPECT_EQ(paper.integrator.step_size, 1e-3);
+  EXPECT_EQ(paper.integrator.birkhoffian_form, "paper");
+}
+
+// ----------------------------------------------------------------------------------------------
+// Scenes written by the tests into a private temporary directory.
+
+/// A minimal valid scene: every required key, no optional one.
+const char* const kMinimalScene = R"(description: minimal test scene
+cart:
+  wheelbase: 1.05
+  rear_half_track: 0.55
+  front_half_track: 0.5
+  rear_wheel_radius: 0.14
+  front_wheel_radius: 0.13
+  rear_body_mass: 140.0
+  rear_body_yaw_inertia: 30.0
+  front_axle_mass: 12.0
+  front_axle_yaw_inertia: 1.0
+  rear_wheel_mass: 3.0
+  rear_wheel_spin_inertia: 0.03
+  rear_wheel_yaw_inertia: 0.025
+  front_wheel_mass: 2.2
+  front_wheel_spin_inertia: 0.019
+  front_wheel_yaw_inertia: 0.013
+  gravity: 9.81
+initial_state:
+  steering_angle: 0.1
+  forward_speed: 2.0
+  steering_rate: 0.3
+duration: 5.0
+integrator:
+  name: rk4
+  step_size: 0.01
+)";
+
+class SceneFiles : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    char pattern[] = "/tmp/scene_test_XXXXXX";
+    ASSERT_NE(mkdtemp(pattern), nullptr);
+    directory_ = pattern;
+  }
+  void TearDown() override {
+    for (const std::string& path : written_) std::remove(path.c_str());
+    rmdir(directory_.c_str());
+  }
+  std::string write(const std::string& name, const std::string& text) {
+    const std::string path = directory_ + "/" + name + ".yaml";
+    std::ofstream(path) << text;
+    written_.push_back(path);
+    return path;
+  }
+  /// kMinimalScene with `from` replaced by `to` (which must occur).
+  static std::string edited(const std::string& from, const std::string& to) {
+    std::string text = kMinimalScene;
+    const std::size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+    return text;
+  }
+
+  std::string directory_;
+  std::vector<std::string> written_;
+};
+
+TEST_F(SceneFiles, MinimalSceneGetsTheDocumentedDefaults) {
+  const Scene scene = load_scene(write("minimal", kMinimalScene));
+  EXPECT_EQ(scene.name, "minimal");
+  EXPECT_EQ(scene.description, "minimal test scene");
+  EXPECT_FALSE(scene.paper_special_case);
+  EXPECT_EQ(scene.initial_state.time, 0.0);
+  EXPECT_EQ(scene.initial_state.x, 0.0);
+  EXPECT_EQ(scene.initial_state.heading, 0.0);
+  EXPECT_EQ(scene.initial_state.arc_length, 0.0);
+  EXPECT_EQ(scene.initial_state.steering_angle, 0.1);
+  EXPECT_EQ(scene.integrator.name, "rk4");
+  EXPECT_EQ(scene.integrator.tolerance, 1e-10);
+  EXPECT_EQ(scene.integrator.birkhoffian_form, "autonomous");
+  EXPECT_EQ(scene.integrator.max_newton_iterations, 30);
+  EXPECT_EQ(scene.integrator.newton_tolerance, 1e-14);
+  EXPECT_EQ(scene.output_rate, 100.0);
+  EXPECT_TRUE(scene.effects.empty());
+  EXPECT_EQ(scene.reference.kind, ReferenceSettings::Kind::kNone);
+}
+
+TEST_F(SceneFiles, DisabledEffectIsLeftOutOfTheScene) {
+  const Scene scene = load_scene(write("disabled", std::string(kMinimalScene) + R"(effects:
+  air_drag: {coefficient: 0.3, enabled: false}
+  steering_damping: {coefficient: 2.0}
+  steering_torque: {profile: step, initial: 1.0, final: 0.0, step_time: 2.0, enabled: false}
+)"));
+  ASSERT_EQ(scene.effects.size(), 1u);
+  EXPECT_EQ(scene.effects[0].name, "steering_damping");
+}
+
+TEST_F(SceneFiles, CommandAndRampProfilesAndShadowReference) {
+  const Scene scene = load_scene(write("profiles", std::string(kMinimalScene) + R"(effects:
+  steering_torque: {profile: command, value: 0.25}
+  drive_torque: {profile: ramp, initial: 0.0, final: 10.0, start_time: 1.0, end_time: 3.0}
+reference:
+  kind: shadow_run
+  integrator: {name: dopri5, step_size: 0.001, tolerance: 1.0e-12}
+)"));
+  ASSERT_EQ(scene.effects.size(), 2u);
+  EXPECT_EQ(scene.effects[0].profile.kind, TorqueProfile::Kind::kCommand);
+  EXPECT_EQ(scene.effects[0].profile.value, 0.25);
+  EXPECT_EQ(scene.effects[1].profile.kind, TorqueProfile::Kind::kRamp);
+  EXPECT_EQ(scene.effects[1].profile.at(2.0), 5.0);
+  EXPECT_EQ(scene.reference.shadow.name, "dopri5");
+  EXPECT_EQ(scene.reference.shadow.tolerance, 1e-12);
+}
+
+/// One malformed file and the key its error must name.
+struct MalformedCase {
+  std::string label;
+  std::string text;
+  std::string key;
+};
+
+TEST_F(SceneFiles, MalformedScenesNameTheFileAndTheKey) {
+  std::string tiny_cart = kMinimalScene;  // every mass and inertia 1e-200: det M underflows to 0
+  for (const char* name : {"rear_body_mass: 140.0", "rear_body_yaw_inertia: 30.0", "front_axle_mass: 12.0",
+                           "front_axle_yaw_inertia: 1.0", "rear_wheel_mass: 3.0", "rear_wheel_spin_inertia: 0.03",
+                           "rear_wheel_yaw_inertia: 0.025", "front_wheel_mass: 2.2", "front_wheel_spin_inertia: 0.019",
+                           "front_wheel_yaw_inertia: 0.013"}) {
+    const std::string entry = name;
+    tiny_cart.replace(tiny_cart.find(entry), entry.size(), entry.substr(0, entry.find(':')) + ": 1.0e-200");
+  }
+  const std::string with_effects = std::string(kMinimalScene) + "effects:\n";
+  const std::vector<MalformedCase> cases = {
+      {"missing_key", edited("  wheelbase: 1.05\n", ""), "cart.wheelbase"},
+      {"missing_section", edited("duration: 5.0\n", ""), "duration"},
+      {"unknown_key", edited("  gravity: 9.81\n", "  gravity: 9.81\n  wheel_base: 1.0\n"), "cart.wheel_base"},
+      {"unknown_top_key", std::string(kMinimalScene) + "colour: red\n", "colour"},
+      {"wrong_type_number", edited("duration: 5.0", "duration: six"), "duration"},
+      {"wrong_type_map", edited("integrator:\n  name: rk4\n  step_size: 0.01\n", "integrator: rk4\n"), "integrator"},
+      {"wrong_type_bool", std::string(kMinimalScene) + "paper_special_case: maybe\n", "paper_special_case"},
+      {"negative_mass", edited("rear_body_mass: 140.0", "rear_body_mass: -140.0"), "cart.rear_body_mass"},
+      {"zero_mass", edited("front_wheel_mass: 2.2", "front_wheel_mass: 0"), "cart.front_wheel_mass"},
+      {"zero_wheelbase", edited("wheelbase: 1.05", "wheelbase: 0.0"), "cart.wheelbase"},
+      {"nan_value", edited("rear_body_yaw_inertia: 30.0", "rear_body_yaw_inertia: .nan"), "cart.rear_body_yaw_inertia"},
+      {"degenerate_mass_matrix", tiny_cart, "cart"},
+      {"paper_flag_wheelbase", std::string(kMinimalScene) + "paper_special_case: true\n", "cart.wheelbase"},
+      {"unknown_effect", with_effects + "  wind_gust: {coefficient: 1.0}\n", "effects.wind_gust"},
+      {"negative_coefficient", with_effects + "  air_drag: {coefficient: -0.3}\n", "effects.air_drag.coefficient"},
+      {"zero_speed_epsilon", with_effects + "  rolling_resistance: {coefficient: 0.01, speed_epsilon: 0}\n",
+       "effects.rolling_resistance.speed_epsilon"},
+      {"missing_profile", with_effects + "  steering_torque: {value: 1.0}\n", "effects.steering_torque.profile"},
+      {"unknown_profile", with_effects + "  steering_torque: {profile: square, value: 1.0}\n",
+       "effects.steering_torque.profile"},
+      {"key_of_other_profile", with_effects + "  steering_torque: {profile: constant, value: 1.0, amplitude: 2.0}\n",
+       "effects.steering_torque.amplitude"},
+      {"ramp_backwards", with_effects + "  drive_torque: {profile: ramp, initial: 0, final: 1, start_time: 3, end_time: 1}\n",
+       "effects.drive_torque.end_time"},
+      {"unknown_integrator", edited("name: rk4", "name: euler"), "integrator.name"},
+      {"zero_step", edited("step_size: 0.01", "step_size: 0.0"), "integrator.step_size"},
+      {"negative_step", edited("step_size: 0.01", "step_size: -0.01"), "integrator.step_size"},
+      {"step_longer_than_run", edited("step_size: 0.01", "step_size: 10.0"), "integrator.step_size"},
+      {"zero_duration", edited("duration: 5.0", "duration: 0"), "duration"},
+      {"negative_duration", edited("duration: 5.0", "duration: -5.0"), "duration"},
+      {"bad_birkhoffian_form", edited("  step_size: 0.01\n", "  step_size: 0.01\n  birkhoffian_form: hamiltonian\n"),
+       "integrator.birkhoffian_form"},
+      {"infinite_initial_speed", edited("forward_speed: 2.0", "forward_speed: .inf"), "initial_state.forward_speed"},
+      {"three_wheel_angles", edited("  steering_rate: 0.3\n", "  steering_rate: 0.3\n  wheel_spin_angles: [0, 0, 0]\n"),
+       "initial_state.wheel_spin_angles"},
+      {"zero_output_rate", std::string(kMinimalScene) + "output_rate: 0\n", "output_rate"},
+      {"analytic_reference_without_paper_flag", std::string(kMinimalScene) + "reference: {kind: paper_analytic}\n",
+       "reference.kind"},
+      {"shadow_without_integrator", std::string(kMinimalScene) + "reference: {kind: shadow_run}\n",
+       "reference.integrator"},
+      {"duplicate_key", std::string(kMinimalScene) + "duration: 7.0\n", "duration"},
+      {"syntax_error", edited("cart:\n", "cart: [1, 2\n"), "(syntax)"},
+      {"empty_file", "", "(document)"},
+  };
+  ASSERT_GE(cases.size(), 15u);
+  for (const MalformedCase& malformed : cases) {
+    const std::string path = write(malformed.label, malformed.text);
+    try {
+      load_scene(path);
+      ADD_FAILURE() << malformed.label << ": accepted";
+    } catch (const SceneError& error) {
+      const std::string message = error.what();
+      EXPECT_EQ(error.file(), path) << malformed.label;
+      EXPECT_EQ(error.key(), malformed.key) << malformed.label << ": " << message;
+      EXPECT_EQ(message.rfind("scene " + path + ": key '" + malformed.key + "': ", 0), 0u) << malformed.label << ": " << message;
+      EXPECT_EQ(message.find('\n'), std::string::npos) << malformed.label;
+    }
+  }
+}
+
+TEST_F(SceneFiles, NonexistentFileNamesTheFile) {
+  const std::string path = directory_ + "/no_such_scene.yaml";
+  try {
+    load_scene(path);
+    ADD_FAILURE() << "loaded a file that does not exist";
+  } catch (const SceneError& error) {
+    EXPECT_EQ(error.file(), path);
+    EXPECT_EQ(error.key(), "(file)");
+    EXPECT_NE(std::string(error.what()).find(path), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace birkhoff_cart
