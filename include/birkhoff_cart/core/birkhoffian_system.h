@@ -25,6 +25,12 @@
 //   template <class S> Vector<S>  from_darboux(const Vector<S>& w, const S& t) const;
 //   template <class S> Vector<S>  darboux_rates(const Vector<S>& w, const S& t) const;        // ẇ, analytic
 //   template <class S> PassiveVector<S> passive_rates(const Vector<S>& z, const S& t) const;  // g(z, t)
+//   // or, when the passive rates read passive coordinates themselves (the cart: ẋ = ω1 cos(θ + χ)
+//   // needs the heading θ, a passive coordinate), instead
+//   template <class S> PassiveVector<S> passive_rates(const Vector<S>& z, const PassiveVector<S>& y,
+//                                                     const S& t) const;                     // g(z, y, t)
+//   // Integrators call the free function passive_coordinate_rates(system, z, y, t), which picks the
+//   // member that exists. y never feeds back into z.
 //
 // The analytic members (K, ∇B, ∂R/∂t, ẇ) are what the integrators use; tests check each against
 // automatic differentiation of R and B (test/unit/birkhoffian_system_test.cpp).
@@ -32,6 +38,8 @@
 
 #include <Eigen/Core>
 #include <Eigen/LU>
+#include <type_traits>
+#include <utility>
 
 namespace birkhoff_cart {
 
@@ -61,6 +69,29 @@ StateVector<System, S> birkhoffian_rates(const System& system, const StateVector
                                                  system.birkhoff_functions_time_derivative(z, t) +
                                                  system.non_birkhoffian_force(z, t);
   return k.partialPivLu().solve(right_hand_side);
+}
+
+namespace birkhoffian_system_detail {
+template <class System, class S, class = void>
+struct HasPassiveRatesWithY : std::false_type {};
+template <class System, class S>
+struct HasPassiveRatesWithY<System, S,
+                            std::void_t<decltype(std::declval<const System&>().passive_rates(
+                                std::declval<const StateVector<System, S>&>(),
+                                std::declval<const PassiveVector<System, S>&>(), std::declval<const S&>()))>>
+    : std::true_type {};
+}  // namespace birkhoffian_system_detail
+
+/// ẏ = g(z, y, t): the system's passive_rates(z, y, t) if it has one, else passive_rates(z, t).
+template <class System, class S>
+PassiveVector<System, S> passive_coordinate_rates(const System& system, const StateVector<System, S>& z,
+                                                  const PassiveVector<System, S>& y, const S& t) {
+  if constexpr (birkhoffian_system_detail::HasPassiveRatesWithY<System, S>::value) {
+    return system.passive_rates(z, y, t);
+  } else {
+    static_cast<void>(y);
+    return system.passive_rates(z, t);
+  }
 }
 
 }  // namespace birkhoff_cart

@@ -1,0 +1,305 @@
+// The cart's Boltzmann–Hamel dynamics as Birkhoffian systems (docs/birkhoffian.md §3), in the
+// variables z = (π1, χ, p1, p2) (state.h BirkhoffianIndex) with passive coordinates
+// y = (x, y, θ, φ1..φ4, W, I2) (state.h PassiveIndex). Two representations of the same motion:
+//
+//  (b) CartAutonomousBirkhoffian: R = (p1, p2, 0, 0), K = K₀, B = H̃ = ½ pᵀ M(χ)⁻¹ p, ∂R/∂t = 0,
+//      Λ = (−(Λ_nh + Q), 0, 0)                                               (eqs. (B.6)–(B.8))
+//      Darboux chart: the identity.
+//  (a) CartPaperBirkhoffian (the paper's form, eqs. (9)–(11), (24)–(25)):
+//      R = e^{t−tₑ} (p1, p2, 0, 0), K = e^{t−tₑ} K₀, B = e^{t−tₑ} H̃, ∂R/∂t = e^{t−tₑ} (p, 0),
+//      Λ = e^{t−tₑ} (−(Λ_nh + Q) − p, 0, 0)                                   (eqs. (B.9)–(B.11))
+//      Darboux chart: w = (π1, χ, e^{t−tₑ} p1, e^{t−tₑ} p2). The structure epoch tₑ is set by
+//      begin_step(t) (tₑ = t) so that e^{t−tₑ} stays O(1) for runs of any length.
+//
+// Both reproduce ṗ = ∂T*/∂q|_ω + Λ_nh + Q, q̇ = ω = M⁻¹ p (derivation eq. (3.6)); with
+// non_birkhoffian_force disabled they are their Birkhoffian parts (Λ = 0, no applied loads):
+// (b) the Hamiltonian flow of H̃, (a) the conformally symplectic ṗ = −∂H̃/∂q − p.
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+
+#include "birkhoff_cart/core/autodiff.h"
+#include "birkhoff_cart/core/birkhoffian_system.h"
+#include "birkhoff_cart/core/cart_model.h"
+#include "birkhoff_cart/core/effects.h"
+#include "birkhoff_cart/core/state.h"
+
+namespace birkhoff_cart {
+
+/// A point of the cart in Birkhoffian variables.
+struct CartBirkhoffianPoint {
+  Eigen::Matrix<double, kBirkhoffianSize, 1> z;  ///< (π1 [m], χ [rad], p1 [kg·m/s], p2 [kg·m²/s])
+  Eigen::Matrix<double, kPassiveSize, 1> y;      ///< (x [m], y [m], θ [rad], φ1..φ4 [rad], W [J], I2 [N·m·s])
+};
+
+/// What both representations share: the model, the loads, conversions and the passive rates.
+class CartBirkhoffianBase {
+ public:
+  static constexpr int kDimension = kBirkhoffianSize;
+  static constexpr int kPassiveDimension = kPassiveSize;
+  template <class S>
+  using Vector = Eigen::Matrix<S, kDimension, 1>;
+  template <class S>
+  using Matrix = Eigen::Matrix<S, kDimension, kDimension>;
+  template <class S>
+  using Passive = Eigen::Matrix<S, kPassiveDimension, 1>;
+
+  /// `model` and `effects` must outlive the system.
+  CartBirkhoffianBase(const CartModel& model, const EffectSet& effects) : model_(&model), effects_(&effects) {}
+
+  const CartModel& model() const { return *model_; }
+  bool non_birkhoffian_force_enabled() const { return non_birkhoffian_force_enabled_; }
+  /// Disabled: Λ = 0 and no applied loads (the Birkhoffian part; K-symplecticity tests).
+  void set_non_birkhoffian_force_enabled(bool enabled) { non_birkhoffian_force_enabled_ = enabled; }
+
+  /// (z, y) of a cart state: p = M(χ) ω (eq. (3.5)).
+  CartBirkhoffianPoint to_birkhoffian(const CartState& state) const;
+  /// The cart state of (z, y) at time t [s]: ω = M(χ)⁻¹ p.
+  CartState to_cart_state(const Vector<double>& z, const Passive<double>& y, double t) const;
+
+  /// ω = M(χ)⁻¹ p [m/s, rad/s].
+  template <class S>
+  Vector2<S> quasi_velocity(const Vector<S>& z) const {
+    return model_->quasi_velocity(z(kSteeringAngleIndex),
+                                  Vector2<S>(z(kForwardMomentumIndex), z(kSteeringMomentumIndex)));
+  }
+
+  /// Q = (Q1 [N], Q2 [N·m]) of the enabled loads; zero when the non-Birkhoffian force is disabled.
+  template <class S>
+  Vector2<S> generalized_force(const Vector<S>& z, const S& t) const {
+    const Vector2<S> omega = quasi_velocity(z);
+    if (!non_birkhoffian_force_enabled_) return Vector2<S>(S(0.0) * omega(0), S(0.0) * omega(0));
+    return effects_->generalized_force(value_of(t), z(kSteeringAngleIndex), omega);
+  }
+
+  /// H̃ = ½ pᵀ M(χ)⁻¹ p = T* [J].
+  template <class S>
+  S hamiltonian(const Vector<S>& z) const {
+    const Vector2<S> omega = quasi_velocity(z);
+    return S(0.5) * (z(kForwardMomentumIndex) * omega(0) + z(kSteeringMomentumIndex) * omega(1));
+  }
+
+  /// ∇H̃ = (0, ∂H̃/∂χ|_p, ω1, ω2) with ∂H̃/∂χ|_p = −∂T*/∂χ|_ω (eq. (B.5)).
+  template <class S>
+  Vector<S> hamiltonian_gradient(const Vector<S>& z) const {
+    const Vector2<S> omega = quasi_velocity(z);
+    Vector<S> gradient;
+    gradient(kArcLengthIndex) = S(0.0) * omega(0);
+    gradient(kSteeringAngleIndex) = -model_->kinetic_energy_steering_derivative(z(kSteeringAngleIndex), omega);
+    gradient(kForwardMomentumIndex) = omega(0);
+    gradient(kSteeringMomentumIndex) = omega(1);
+    return gradient;
+  }
+
+  /// The physical momentum rate ṗ = ∂T*/∂q|_ω + Λ_nh + Q (eq. (3.6)) [N, N·m].
+  template <class S>
+  Vector2<S> momentum_rate(const Vector<S>& z, const S& t) const {
+    const Vector2<S> omega = quasi_velocity(z);
+    const S& chi = z(kSteeringAngleIndex);
+    Vector2<S> rate = model_->nonholonomic_force(chi, omega) + generalized_force(z, t);
+    rate(1) += model_->kinetic_energy_steering_derivative(chi, omega);
+    return rate;
+  }
+
+  /// ẏ = g(z, y, t) = (ẋ, ẏ, θ̇, φ̇1..φ̇4, ω·Q, Q2) (eqs. (2.3)–(2.4), (3.7)). Reads only the heading
+  /// θ = y(kHeadingIndex) of y (ẋ, ẏ need it), and θ̇ depends on z alone: g is triangular in y.
+  template <class S>
+  Passive<S> passive_rates(const Vector<S>& z, const Passive<S>& y, const S& t) const {
+    const Vector2<S> omega = quasi_velocity(z);
+    const CoordinateRates<S> rates = model_->coordinate_rates(y(kHeadingIndex), z(kSteeringAngleIndex), omega);
+    const Vector2<S> force = generalized_force(z, t);
+    Passive<S> rate;
+    rate(kXIndex) = rates.x_rate;
+    rate(kYIndex) = rates.y_rate;
+    rate(kHeadingIndex) = rates.heading_rate;
+    for (int wheel = 0; wheel < 4; ++wheel) rate(kWheel1Index + wheel) = rates.wheel_spin_rate[wheel];
+    rate(kAppliedWorkIndex) = omega.dot(force);
+    rate(kSteeringImpulseIndex) = force(1);
+    return rate;
+  }
+
+ protected:
+  const CartModel* model_;
+  const EffectSet* effects_;
+  bool non_birkhoffian_force_enabled_ = true;
+};
+
+namespace cart_birkhoffian_detail {
+template <class S>
+S zero_like(const S& s) {
+  return S(0.0) * s;
+}
+}  // namespace cart_birkhoffian_detail
+
+/// Representation (b): autonomous canonical form, K = K₀ (eqs. (B.6)–(B.8)).
+class CartAutonomousBirkhoffian : public CartBirkhoffianBase {
+ public:
+  using CartBirkhoffianBase::CartBirkhoffianBase;
+
+  /// No structure epoch: K = K₀ does not depend on time.
+  void begin_step(double /*t*/) {}
+
+  /// R = (p1, p2, 0, 0).
+  template <class S>
+  Vector<S> birkhoff_functions(const Vector<S>& z, const S& /*t*/) const {
+    Vector<S> r;
+    r << z(kForwardMomentumIndex), z(kSteeringMomentumIndex), cart_birkhoffian_detail::zero_like(z(0)),
+        cart_birkhoffian_detail::zero_like(z(0));
+    return r;
+  }
+  /// B = H̃ [J].
+  template <class S>
+  S birkhoffian(const Vector<S>& z, const S& /*t*/) const {
+    return hamiltonian(z);
+  }
+  template <class S>
+  Matrix<S> structure_matrix(const Vector<S>& /*z*/, const S& /*t*/) const {
+    return canonical_structure<kDimension>().template cast<S>();
+  }
+  template <class S>
+  Vector<S> birkhoffian_gradient(const Vector<S>& z, const S& /*t*/) const {
+    return hamiltonian_gradient(z);
+  }
+  template <class S>
+  Vector<S> birkhoff_functions_time_derivative(const Vector<S>& z, const S& /*t*/) const {
+    return Vector<S>::Constant(cart_birkhoffian_detail::zero_like(z(0)));
+  }
+  /// Λ = (−(Λ_nh + Q), 0, 0) (eq. (B.7)).
+  template <class S>
+  Vector<S> non_birkhoffian_force(const Vector<S>& z, const S& t) const {
+    Vector<S> force = Vector<S>::Constant(cart_birkhoffian_detail::zero_like(z(0)));
+    if (!non_birkhoffian_force_enabled_) return force;
+    const Vector2<S> omega = quasi_velocity(z);
+    const Vector2<S> load = model_->nonholonomic_force(z(kSteeringAngleIndex), omega) + generalized_force(z, t);
+    force(kArcLengthIndex) = -load(0);
+    force(kSteeringAngleIndex) = -load(1);
+    return force;
+  }
+  /// Identity chart.
+  template <class S>
+  Vector<S> to_darboux(const Vector<S>& z, const S& /*t*/) const {
+    return z;
+  }
+  template <class S>
+  Vector<S> from_darboux(const Vector<S>& w, const S& /*t*/) const {
+    return w;
+  }
+  /// ẇ = ż = (ω, ṗ) with ṗ = ∂T*/∂q|_ω + Λ_nh + Q (enabled) or −∂H̃/∂q (Birkhoffian part).
+  template <class S>
+  Vector<S> darboux_rates(const Vector<S>& w, const S& t) const {
+    const Vector2<S> omega = quasi_velocity(w);
+    Vector<S> rate;
+    rate(kArcLengthIndex) = omega(0);
+    rate(kSteeringAngleIndex) = omega(1);
+    if (non_birkhoffian_force_enabled_) {
+      const Vector2<S> p_rate = momentum_rate(w, t);
+      rate(kForwardMomentumIndex) = p_rate(0);
+      rate(kSteeringMomentumIndex) = p_rate(1);
+    } else {
+      rate(kForwardMomentumIndex) = cart_birkhoffian_detail::zero_like(omega(0));
+      rate(kSteeringMomentumIndex) = model_->kinetic_energy_steering_derivative(w(kSteeringAngleIndex), omega);
+    }
+    return rate;
+  }
+};
+
+/// Representation (a): the paper's time-dependent form, K = e^{t−tₑ} K₀ (eqs. (B.9)–(B.11)).
+class CartPaperBirkhoffian : public CartBirkhoffianBase {
+ public:
+  using CartBirkhoffianBase::CartBirkhoffianBase;
+
+  /// Sets the structure epoch tₑ = t [s]: a constant factor e^{−tₑ} on R and B leaves Birkhoff's
+  /// equations unchanged and keeps e^{t−tₑ} = O(1) (no overflow at t ≈ 709 s).
+  void begin_step(double t) { structure_epoch_ = t; }
+  double structure_epoch() const { return structure_epoch_; }
+
+  /// e^{t−tₑ} [-].
+  template <class S>
+  S conformal_factor(const S& t) const {
+    using std::exp;
+    return exp(t - structure_epoch_);
+  }
+  /// R = e^{t−tₑ} (p1, p2, 0, 0).
+  template <class S>
+  Vector<S> birkhoff_functions(const Vector<S>& z, const S& t) const {
+    const S e = conformal_factor(t);
+    Vector<S> r;
+    r << e * z(kForwardMomentumIndex), e * z(kSteeringMomentumIndex), cart_birkhoffian_detail::zero_like(e),
+        cart_birkhoffian_detail::zero_like(e);
+    return r;
+  }
+  /// B = e^{t−tₑ} H̃.
+  template <class S>
+  S birkhoffian(const Vector<S>& z, const S& t) const {
+    return conformal_factor(t) * hamiltonian(z);
+  }
+  /// K = e^{t−tₑ} K₀.
+  template <class S>
+  Matrix<S> structure_matrix(const Vector<S>& /*z*/, const S& t) const {
+    return canonical_structure<kDimension>().template cast<S>() * conformal_factor(t);
+  }
+  template <class S>
+  Vector<S> birkhoffian_gradient(const Vector<S>& z, const S& t) const {
+    return hamiltonian_gradient(z) * conformal_factor(t);
+  }
+  /// ∂R/∂t = e^{t−tₑ} (p1, p2, 0, 0).
+  template <class S>
+  Vector<S> birkhoff_functions_time_derivative(const Vector<S>& z, const S& t) const {
+    return birkhoff_functions(z, t);
+  }
+  /// Λ = e^{t−tₑ} (−(Λ_nh + Q) − p, 0, 0) (eq. (B.10)); zero when disabled.
+  template <class S>
+  Vector<S> non_birkhoffian_force(const Vector<S>& z, const S& t) const {
+    Vector<S> force = Vector<S>::Constant(cart_birkhoffian_detail::zero_like(z(0)));
+    if (!non_birkhoffian_force_enabled_) return force;
+    const S e = conformal_factor(t);
+    const Vector2<S> omega = quasi_velocity(z);
+    const Vector2<S> load = model_->nonholonomic_force(z(kSteeringAngleIndex), omega) + generalized_force(z, t);
+    force(kArcLengthIndex) = -e * (load(0) + z(kForwardMomentumIndex));
+    force(kSteeringAngleIndex) = -e * (load(1) + z(kSteeringMomentumIndex));
+    return force;
+  }
+  /// w = D(z, t) = (π1, χ, e^{t−tₑ} p1, e^{t−tₑ} p2) (eq. (B.11)).
+  template <class S>
+  Vector<S> to_darboux(const Vector<S>& z, const S& t) const {
+    const S e = conformal_factor(t);
+    Vector<S> w = z;
+    w(kForwardMomentumIndex) *= e;
+    w(kSteeringMomentumIndex) *= e;
+    return w;
+  }
+  template <class S>
+  Vector<S> from_darboux(const Vector<S>& w, const S& t) const {
+    const S inverse = 1.0 / conformal_factor(t);
+    Vector<S> z = w;
+    z(kForwardMomentumIndex) *= inverse;
+    z(kSteeringMomentumIndex) *= inverse;
+    return z;
+  }
+  /// ẇ = D_z ż + ∂_t D = (ω, e^{t−tₑ} (ṗ + p)): with Λ, ṗ + p = ∂T*/∂q|_ω + Λ_nh + Q + p; without,
+  /// ṗ = −∂H̃/∂q − p, so ẇ_p = e^{t−tₑ} ∂T*/∂q|_ω (Hamiltonian in the chart with H_w = e^{t−tₑ} H̃).
+  template <class S>
+  Vector<S> darboux_rates(const Vector<S>& w, const S& t) const {
+    const S e = conformal_factor(t);
+    const Vector<S> z = from_darboux(w, t);
+    const Vector2<S> omega = quasi_velocity(z);
+    Vector<S> rate;
+    rate(kArcLengthIndex) = omega(0);
+    rate(kSteeringAngleIndex) = omega(1);
+    if (non_birkhoffian_force_enabled_) {
+      const Vector2<S> p_rate = momentum_rate(z, t);
+      rate(kForwardMomentumIndex) = e * (p_rate(0) + z(kForwardMomentumIndex));
+      rate(kSteeringMomentumIndex) = e * (p_rate(1) + z(kSteeringMomentumIndex));
+    } else {
+      rate(kForwardMomentumIndex) = cart_birkhoffian_detail::zero_like(e);
+      rate(kSteeringMomentumIndex) = e * model_->kinetic_energy_steering_derivative(z(kSteeringAngleIndex), omega);
+    }
+    return rate;
+  }
+
+ private:
+  double structure_epoch_ = 0.0;  ///< tₑ [s]
+};
+
+}  // namespace birkhoff_cart
