@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <string>
@@ -140,6 +141,17 @@ TEST(ShippedScenes, EffectParametersMatchTheTable) {
   EXPECT_EQ(slalom.reference.shadow.name, "dopri5");
   EXPECT_EQ(slalom.reference.shadow.tolerance, 1e-12);
   EXPECT_EQ(load_scene(scene_path("free_coast")).reference.kind, ReferenceSettings::Kind::kNone);
+}
+
+TEST(ShippedScenes, EveryFileInTheSceneDirectoryLoads) {
+  const std::filesystem::path directory = std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes";
+  int loaded = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(directory)) {
+    if (entry.path().extension() != ".yaml") continue;
+    EXPECT_NO_THROW(load_scene(entry.path().string())) << entry.path();
+    ++loaded;
+  }
+  EXPECT_GE(loaded, 10);  // the ten scenes of docs/scenes.md, and any added since
 }
 
 TEST(ShippedScenes, PaperSpecialCase) {
@@ -319,6 +331,8 @@ TEST_F(SceneFiles, MalformedScenesNameTheFileAndTheKey) {
       {"bad_birkhoffian_form", edited("  step_size: 0.01\n", "  step_size: 0.01\n  birkhoffian_form: hamiltonian\n"),
        "integrator.birkhoffian_form"},
       {"infinite_initial_speed", edited("forward_speed: 2.0", "forward_speed: .inf"), "initial_state.forward_speed"},
+      {"nan_wheel_angle", edited("  steering_rate: 0.3\n", "  steering_rate: 0.3\n  wheel_spin_angles: [0, 0, .nan, 0]\n"),
+       "initial_state.wheel_spin_angles[2]"},
       {"three_wheel_angles", edited("  steering_rate: 0.3\n", "  steering_rate: 0.3\n  wheel_spin_angles: [0, 0, 0]\n"),
        "initial_state.wheel_spin_angles"},
       {"zero_output_rate", std::string(kMinimalScene) + "output_rate: 0\n", "output_rate"},

@@ -1,5 +1,5 @@
 // A scene: the cart, its initial state, the effects it enables, the integrator and the reference.
-// Loaded from YAML (config/scenes/*.yaml, schema in README "Scene files") and validated; the
+// Loaded from YAML (config/scenes/*.yaml, schema in docs/scenes.md) and validated; the
 // struct itself is plain data.
 #pragma once
 
