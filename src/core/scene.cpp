@@ -139,6 +139,9 @@ Scene read_scene(const SceneReader& reader, const YAML::Node& root, const std::s
   scene.name = file_stem(path);
   scene.source_path = path;
   scene.description = reader.text(reader.required(root, "", "description"), "description");
+  if (scene.description.empty() || scene.description.find('\n') != std::string::npos) {
+    reader.fail("description", "must be one non-empty line");
+  }
   scene.cart = read_cart(reader, reader.required(root, "", "cart"));
   scene.paper_special_case = reader.optional_boolean(root, "", "paper_special_case", false);
   scene.initial_state = read_initial_state(reader, reader.required(root, "", "initial_state"));

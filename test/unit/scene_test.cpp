@@ -298,6 +298,8 @@ TEST_F(SceneFiles, MalformedScenesNameTheFileAndTheKey) {
   }
   const std::string with_effects = std::string(kMinimalScene) + "effects:\n";
   const std::vector<MalformedCase> cases = {
+      {"two_line_description", edited("description: minimal test scene\n", "description: |\n  two\n  lines\n"),
+       "description"},
       {"missing_key", edited("  wheelbase: 1.05\n", ""), "cart.wheelbase"},
       {"missing_section", edited("duration: 5.0\n", ""), "duration"},
       {"unknown_key", edited("  gravity: 9.81\n", "  gravity: 9.81\n  wheel_base: 1.0\n"), "cart.wheel_base"},
