@@ -249,6 +249,12 @@ class FullCoordinateModel {
   /// [N, N·m]) is written to `multipliers` when given.
   Vector8 acceleration(const Vector8& q, const Vector8& qd, const AppliedLoads& loads,
                        Eigen::Matrix<double, kConstraintCount, 1>* multipliers = nullptr) const {
+    return acceleration(q, qd, applied_force(loads), multipliers);
+  }
+
+  /// The same for any generalized force f in the eight coordinates [N, N·m].
+  Vector8 acceleration(const Vector8& q, const Vector8& qd, const Vector8& force,
+                       Eigen::Matrix<double, kConstraintCount, 1>* multipliers = nullptr) const {
     constexpr int kSize = kCoordinateCount + kConstraintCount;
     Eigen::Matrix<double, kSize, kSize> kkt = Eigen::Matrix<double, kSize, kSize>::Zero();
     const ConstraintMatrix a = constraints(q);
@@ -256,7 +262,7 @@ class FullCoordinateModel {
     kkt.topRightCorner<kCoordinateCount, kConstraintCount>() = a.transpose();
     kkt.bottomLeftCorner<kConstraintCount, kCoordinateCount>() = a;
     Eigen::Matrix<double, kSize, 1> right;
-    right.head<kCoordinateCount>() = applied_force(loads) - velocity_terms(q, qd);
+    right.head<kCoordinateCount>() = force - velocity_terms(q, qd);
     right.tail<kConstraintCount>() = -constraint_velocity_terms(q, qd);
     const Eigen::Matrix<double, kSize, 1> solution = kkt.fullPivLu().solve(right);
     if (multipliers != nullptr) *multipliers = -solution.tail<kConstraintCount>();

@@ -7,11 +7,18 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <iostream>
+#include <memory>
 #include <random>
 
 #include "birkhoff_cart/core/autodiff.h"
 #include "birkhoff_cart/core/cart_model.h"
+#include "birkhoff_cart/core/effects.h"
+#include "birkhoff_cart/core/effects/air_drag.h"
+#include "birkhoff_cart/core/effects/rolling_resistance.h"
+#include "birkhoff_cart/core/effects/steering_damping.h"
+#include "birkhoff_cart/core/effects/steering_stiffness.h"
 #include "full_coordinate_model.h"
 
 namespace birkhoff_cart {
@@ -81,24 +88,33 @@ double paper_printed_mu1(const CartParameters& p) {
          p.rear_wheel_spin_inertia / (p.rear_wheel_radius * p.rear_wheel_radius) * (1.0 - c2 / l2);
 }
 
+/// Further loads of the reduced model, Q(t, χ, ω) [N, N·m] (e.g. an EffectSet).
+using ReducedLoads = std::function<Vector2<double>(double, double, const Vector2<double>&)>;
+/// Further loads of the full model, f(q, q̇) in the eight coordinates [N, N·m].
+using FullLoads = std::function<Vector8(const Vector8&, const Vector8&)>;
+
 /// dy/dt of the reduced model: reconstruction eqs. (2.3)–(2.4), χ̇ = ω2, ω̇ from `acceleration`.
 template <class Acceleration>
-ReducedState reduced_rate(const CartModel& model, const LoadHistory& history, const Acceleration& acceleration,
-                          double time, const ReducedState& y) {
+ReducedState reduced_rate(const CartModel& model, const LoadHistory& history, const ReducedLoads& extra,
+                          const Acceleration& acceleration, double time, const ReducedState& y) {
   const Vector2<double> w(y(8), y(9));
   const CoordinateRates<double> rates = model.coordinate_rates(y(2), y(3), w);
-  const Vector2<double> w_rate =
-      acceleration(y(3), w, generalized_force(model.parameters(), history.at(time), y(3)));
+  Vector2<double> force = generalized_force(model.parameters(), history.at(time), y(3));
+  if (extra) force += extra(time, y(3), w);
+  const Vector2<double> w_rate = acceleration(y(3), w, force);
   ReducedState rate;
   rate << rates.x_rate, rates.y_rate, rates.heading_rate, w(1), rates.wheel_spin_rate[0], rates.wheel_spin_rate[1],
       rates.wheel_spin_rate[2], rates.wheel_spin_rate[3], w_rate(0), w_rate(1);
   return rate;
 }
 
-FullState full_rate(const FullCoordinateModel& model, const LoadHistory& history, double time, const FullState& y) {
+FullState full_rate(const FullCoordinateModel& model, const LoadHistory& history, const FullLoads& extra,
+                    double time, const FullState& y) {
   const Vector8 q = y.head<8>(), qd = y.tail<8>();
+  Vector8 force = FullCoordinateModel::applied_force(history.at(time));
+  if (extra) force += extra(q, qd);
   FullState rate;
-  rate << qd, model.acceleration(q, qd, history.at(time));
+  rate << qd, model.acceleration(q, qd, force);
   return rate;
 }
 
@@ -123,7 +139,8 @@ struct Comparison {
 template <class Acceleration>
 Comparison compare_trajectories(const CartParameters& parameters, const Acceleration& reduced_acceleration,
                                 const LoadHistory& history, const Vector8& q0, double forward_speed,
-                                double steering_rate, double duration) {
+                                double steering_rate, double duration, const ReducedLoads& reduced_extra = {},
+                                const FullLoads& full_extra = {}) {
   const CartModel model(parameters);
   const FullCoordinateModel full(parameters);
   FullState full_state;
@@ -131,9 +148,9 @@ Comparison compare_trajectories(const CartParameters& parameters, const Accelera
   ReducedState reduced_state;
   reduced_state << q0, forward_speed, steering_rate;
   const auto reduced_rhs = [&](double t, const ReducedState& y) {
-    return reduced_rate(model, history, reduced_acceleration, t, y);
+    return reduced_rate(model, history, reduced_extra, reduced_acceleration, t, y);
   };
-  const auto full_rhs = [&](double t, const FullState& y) { return full_rate(full, history, t, y); };
+  const auto full_rhs = [&](double t, const FullState& y) { return full_rate(full, history, full_extra, t, y); };
   Comparison result;
   result.min_steering_angle = result.max_steering_angle = q0(full_model::kSteering);
   const int steps = static_cast<int>(std::lround(duration / kStep));
@@ -290,6 +307,70 @@ TEST(IndependentModel, TrajectoriesAgreeWhileSteeringSwingsThroughRightAngles) {
             << result.min_steering_angle << ", " << result.max_steering_angle << "] rad\n";
   EXPECT_LT(result.min_steering_angle, -kPi / 2);
   EXPECT_GT(result.max_steering_angle, kPi / 2);
+  EXPECT_LT(result.max_difference, kTrajectoryTolerance);
+  EXPECT_LT(result.max_constraint_residual, kConstraintDriftTolerance);
+}
+
+
+// The dissipative effects (docs eqs. (4.3)–(4.6)) as the core's EffectSet computes Q, against the
+// same loads applied body by body in the eight coordinates: a torque −c_rr N_i r_i tanh(r_i φ̇_i/v_eps)
+// on each wheel's φ_i, the drag force −k|v_A|v_A at A through A's position Jacobian, and hinge
+// torques −b χ̇ and −k_s χ on the χ coordinate.
+TEST(IndependentModel, TrajectoriesAgreeWithRollingResistanceAirDragAndHingeSpringDamper) {
+  const CartParameters p;
+  const CartModel model(p);
+  constexpr double kRolling = 0.015;        // c_rr [-]
+  constexpr double kSpeedEpsilon = 0.05;    // v_eps [m/s]
+  constexpr double kDrag = 0.3;             // k [N·s²/m²]
+  constexpr double kDamping = 2.0;          // b [N·m·s/rad]
+  constexpr double kStiffness = 40.0;       // k_s [N·m/rad]
+  EffectSet effects;
+  effects.add(std::make_unique<RollingResistance>(model, kRolling, kSpeedEpsilon));
+  effects.add(std::make_unique<AirDrag>(kDrag));
+  effects.add(std::make_unique<SteeringDamping>(kDamping));
+  effects.add(std::make_unique<SteeringStiffness>(kStiffness));
+  const ReducedLoads reduced_effects = [&](double t, double chi, const Vector2<double>& w) {
+    EffectInput input;
+    input.time = t;
+    input.steering_angle = chi;
+    input.forward_speed = w(0);
+    input.steering_rate = w(1);
+    return Vector2<double>(effects.evaluate(input).force);
+  };
+  const FullCoordinateModel full(p);
+  const double rear_load = (0.5 * p.rear_body_mass + p.rear_wheel_mass) * p.gravity;    // N1, N2 [N]
+  const double front_load = (0.5 * p.front_axle_mass + p.front_wheel_mass) * p.gravity;  // N3, N4 [N]
+  const FullLoads full_effects = [&](const Vector8& q, const Vector8& qd) {
+    Vector8 force = Vector8::Zero();
+    for (int wheel = 0; wheel < 4; ++wheel) {
+      const double radius = wheel < 2 ? p.rear_wheel_radius : p.front_wheel_radius;
+      const double load = wheel < 2 ? rear_load : front_load;
+      const double spin_rate = qd(full_model::kSpin1 + wheel);
+      force(full_model::kSpin1 + wheel) += -kRolling * load * radius * std::tanh(radius * spin_rate / kSpeedEpsilon);
+    }
+    const full_model::Body& rear_body = full.bodies()[0];  // centre at A
+    const Eigen::Matrix<double, 2, 8> jacobian = full_model::position_jacobian<double>(rear_body, q);
+    const Eigen::Vector2d velocity = jacobian * qd;  // v_A [m/s]
+    force += jacobian.transpose() * (-kDrag * velocity.norm() * velocity);
+    force(full_model::kSteering) += -kDamping * qd(full_model::kSteering) - kStiffness * q(full_model::kSteering);
+    return force;
+  };
+  LoadHistory history;
+  history.steering_amplitude = 8.0;
+  history.steering_frequency = 1.1;
+  history.drive_mean = 30.0;
+  history.drive_amplitude = 20.0;
+  history.drive_frequency = 0.8;
+  Vector8 q0;
+  q0 << 0.0, 0.0, 0.2, -0.3, 0.0, 0.0, 0.0, 0.0;
+  const auto cart_model_acceleration = [&](double chi, const Vector2<double>& w, const Vector2<double>& force) {
+    return model.quasi_acceleration(chi, w, force);
+  };
+  const Comparison result = compare_trajectories(p, cart_model_acceleration, history, q0, 2.0, 0.5, 5.0,
+                                                 reduced_effects, full_effects);
+  std::cout << "[ measured ] 5 s, all dissipative effects: max disagreement " << result.max_difference
+            << ", χ in [" << result.min_steering_angle << ", " << result.max_steering_angle << "] rad, final ω1 "
+            << result.final_forward_speed << " m/s\n";
   EXPECT_LT(result.max_difference, kTrajectoryTolerance);
   EXPECT_LT(result.max_constraint_residual, kConstraintDriftTolerance);
 }
