@@ -6,7 +6,7 @@
 //   err = max_i |x̂_i − x_i| / (ε_abs + ε_rel (|x_i| + h |ẋ_i|)),   accept if err ≤ 1,
 //
 // with ε_abs = ε_rel = IntegratorSettings::tolerance. It integrates the joint system
-// (ż, ẏ) = (K(z,t)⁻¹(∇B + ∂R/∂t + Λ), g(z, t)) over each simulator step [t, t + h] with
+// (ż, ẏ) = (K(z,t)⁻¹(∇B + ∂R/∂t + Λ), g(z, y, t)) over each simulator step [t, t + h] with
 // odeint's integrate_adaptive (the last internal step is shortened to land on t + h exactly).
 //
 // Determinism: the internal step-size guess is carried from one simulator step to the next (the
@@ -46,7 +46,7 @@ class DormandPrince5 {
   }
 
   double tolerance() const { return tolerance_; }
-  /// The internal step-size guess for the next simulator step [s] (0: none yet, use h).
+  /// The magnitude of the internal step-size guess for the next simulator step [s] (0: none yet, use h).
   double step_size_guess() const { return step_size_guess_; }
   /// Forget the step-size guess (the next step starts from h, as after construction).
   void reset() { step_size_guess_ = 0.0; }
@@ -67,9 +67,11 @@ class DormandPrince5 {
     std::uint64_t evaluations = 0;
     auto rates = [&system, &evaluations](const Joint& state, Joint& state_rate, double time) {
       StateVector<System, double> z_now;
+      PassiveVector<System, double> y_now;
       for (int i = 0; i < n; ++i) z_now(i) = state[i];
-      const StateVector<System, double> z_rate = birkhoffian_rates(system, z_now, time);  // ż = f(z, t)
-      const PassiveVector<System, double> y_rate = system.passive_rates(z_now, time);     // ẏ = g(z, t)
+      for (int i = 0; i < m; ++i) y_now(i) = state[n + i];
+      const StateVector<System, double> z_rate = birkhoffian_rates(system, z_now, time);               // ż = f(z, t)
+      const PassiveVector<System, double> y_rate = passive_coordinate_rates(system, z_now, y_now, time);  // ẏ = g(z, y, t)
       for (int i = 0; i < n; ++i) state_rate[i] = z_rate(i);
       for (int i = 0; i < m; ++i) state_rate[n + i] = y_rate(i);
       ++evaluations;
@@ -86,7 +88,8 @@ class DormandPrince5 {
     };
 
     auto controlled = odeint::make_controlled(tolerance_, tolerance_, odeint::runge_kutta_dopri5<Joint>());
-    const double first_guess = step_size_guess_ > 0.0 ? step_size_guess_ : h;
+    // First internal step: the carried guess (a magnitude), with the sign of h (h < 0 runs backwards).
+    const double first_guess = step_size_guess_ > 0.0 ? std::copysign(step_size_guess_, h) : h;
     try {
       // x(t + h) ← adaptive dopri5 steps over [t, t + h]
       odeint::integrate_adaptive(controlled, rates, x, t, end_time, first_guess, observer);
@@ -100,8 +103,8 @@ class DormandPrince5 {
 
     for (int i = 0; i < n; ++i) z(i) = x[i];
     for (int i = 0; i < m; ++i) y(i) = x[n + i];
-    if (last_free_step > 0.0) step_size_guess_ = last_free_step;
-    else if (step_size_guess_ <= 0.0) step_size_guess_ = h;
+    if (last_free_step != 0.0) step_size_guess_ = std::abs(last_free_step);
+    else if (step_size_guess_ <= 0.0) step_size_guess_ = std::abs(h);
   }
 
  private:

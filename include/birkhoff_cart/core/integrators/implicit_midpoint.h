@@ -2,7 +2,8 @@
 // birkhoff2. Scheme (one stage Gauss–Legendre; Butcher tableau 1/2 | 1/2 ; 1):
 //
 //   z⁽ᵏ⁺¹⁾ = z⁽ᵏ⁾ + h f(z̄, tₖ + h/2),   z̄ = (z⁽ᵏ⁾ + z⁽ᵏ⁺¹⁾)/2,   f(z, t) = K(z,t)⁻¹ (∇B + ∂R/∂t + Λ),
-//   y⁽ᵏ⁺¹⁾ = y⁽ᵏ⁾ + h g(z̄, tₖ + h/2)     (passive coordinates at the midpoint),
+//   y⁽ᵏ⁺¹⁾ = y⁽ᵏ⁾ + h g(z̄, ȳ, tₖ + h/2), ȳ = (y⁽ᵏ⁾ + y⁽ᵏ⁺¹⁾)/2   (passive coordinates at the midpoint,
+//            by the same fixed-point sweeps as birkhoff2: BirkhoffSymplectic2::passive_midpoint),
 //
 // solved for z⁽ᵏ⁺¹⁾ by Newton's method with the AD Jacobian I − (h/2) ∂f/∂z(z̄) (newton.h), from the
 // explicit Euler predictor. Order 2, symmetric (self-adjoint).
@@ -19,6 +20,7 @@
 
 #include "birkhoff_cart/core/birkhoffian_system.h"
 #include "birkhoff_cart/core/diagnostics.h"
+#include "birkhoff_cart/core/integrators/birkhoff_symplectic.h"
 #include "birkhoff_cart/core/integrators/newton.h"
 
 namespace birkhoff_cart {
@@ -58,10 +60,9 @@ class ImplicitMidpoint {
     ++statistics.rhs_evaluations;
     // z⁽ᵏ⁺¹⁾ ← root of F by Newton
     solve_newton<n>(make_residual, z, newton_, t, statistics);
-    // z̄ ← (z⁽ᵏ⁾ + z⁽ᵏ⁺¹⁾)/2;  y⁽ᵏ⁺¹⁾ ← y⁽ᵏ⁾ + h g(z̄, tₖ + h/2)
+    // z̄ ← (z⁽ᵏ⁾ + z⁽ᵏ⁺¹⁾)/2;  y⁽ᵏ⁺¹⁾ ← y⁽ᵏ⁾ + h g(z̄, ȳ, tₖ + h/2)
     const StateVector<System, S> z_mid = S(0.5) * (z_start + z);
-    y += h * system.passive_rates(z_mid, S(mid_time));
-    ++statistics.rhs_evaluations;
+    y = BirkhoffSymplectic2::passive_midpoint(system, z_mid, y, mid_time, h, statistics);
   }
 
  private:

@@ -2,7 +2,9 @@
 // Birkhoffian variables z (and the passive coordinates y) as birkhoff2/birkhoff4, through the
 // solved form of Birkhoff's equations (docs/birkhoffian.md eq. (B.1)):
 //
-//   ż = K(z,t)⁻¹ (∇B + ∂R/∂t + Λ) =: f(z, t),     ẏ = g(z, t)   (System::passive_rates).
+//   ż = K(z,t)⁻¹ (∇B + ∂R/∂t + Λ) =: f(z, t),     ẏ = g(z, y, t)   (passive_coordinate_rates).
+//
+// Each stage carries z and y together (the cart's g reads the heading θ, a passive coordinate).
 //
 // They are generic in the scalar S (double or an AD jet) so that the step map can be
 // differentiated (the K-symplecticity test compares them with the Birkhoffian schemes). Neither
@@ -19,14 +21,14 @@ namespace birkhoff_cart {
 
 namespace runge_kutta_detail {
 
-/// The joint right-hand side (ż, ẏ) = (f(z, t), g(z, t)) at a scalar time t [s].
+/// The joint right-hand side (ż, ẏ) = (f(z, t), g(z, y, t)) at a scalar time t [s].
 template <class System, class S>
-void joint_rates(const System& system, const StateVector<System, S>& z, double t,
-                 StateVector<System, S>& z_rate, PassiveVector<System, S>& y_rate,
+void joint_rates(const System& system, const StateVector<System, S>& z, const PassiveVector<System, S>& y,
+                 double t, StateVector<System, S>& z_rate, PassiveVector<System, S>& y_rate,
                  StepStatistics& statistics) {
   const S time(t);
   z_rate = birkhoffian_rates(system, z, time);
-  y_rate = system.passive_rates(z, time);
+  y_rate = passive_coordinate_rates(system, z, y, time);
   ++statistics.rhs_evaluations;
 }
 
@@ -55,9 +57,10 @@ struct HeunRungeKutta2 {
     using runge_kutta_detail::joint_rates;
     StateVector<System, S> k1_z, k2_z;
     PassiveVector<System, S> k1_y, k2_y;
-    joint_rates(system, z, t, k1_z, k1_y, statistics);               // k₁ = f(z⁽ᵏ⁾, tₖ)
+    joint_rates(system, z, y, t, k1_z, k1_y, statistics);            // k₁ = f(z⁽ᵏ⁾, tₖ)
     const StateVector<System, S> z_euler = z + h * k1_z;             // z̃ = z⁽ᵏ⁾ + h k₁
-    joint_rates(system, z_euler, t + h, k2_z, k2_y, statistics);      // k₂ = f(z̃, tₖ + h)
+    const PassiveVector<System, S> y_euler = y + h * k1_y;           // ỹ = y⁽ᵏ⁾ + h g₁
+    joint_rates(system, z_euler, y_euler, t + h, k2_z, k2_y, statistics);  // k₂ = f(z̃, tₖ + h)
     z += (0.5 * h) * (k1_z + k2_z);                                  // z⁽ᵏ⁺¹⁾ ← z⁽ᵏ⁾ + h/2 (k₁ + k₂)
     y += (0.5 * h) * (k1_y + k2_y);                                  // y⁽ᵏ⁺¹⁾ ← y⁽ᵏ⁾ + h/2 (g₁ + g₂)
   }
@@ -83,13 +86,15 @@ struct ClassicalRungeKutta4 {
     StateVector<System, S> k1_z, k2_z, k3_z, k4_z;
     PassiveVector<System, S> k1_y, k2_y, k3_y, k4_y;
     const double half = 0.5 * h;
-    joint_rates(system, z, t, k1_z, k1_y, statistics);                                // k₁ = f(z⁽ᵏ⁾, tₖ)
-    joint_rates(system, StateVector<System, S>(z + half * k1_z), t + half, k2_z, k2_y,
-                statistics);                                                          // k₂ = f(z⁽ᵏ⁾ + h/2 k₁, tₖ + h/2)
-    joint_rates(system, StateVector<System, S>(z + half * k2_z), t + half, k3_z, k3_y,
-                statistics);                                                          // k₃ = f(z⁽ᵏ⁾ + h/2 k₂, tₖ + h/2)
-    joint_rates(system, StateVector<System, S>(z + h * k3_z), t + h, k4_z, k4_y,
-                statistics);                                                          // k₄ = f(z⁽ᵏ⁾ + h k₃, tₖ + h)
+    using Z = StateVector<System, S>;
+    using Y = PassiveVector<System, S>;
+    joint_rates(system, z, y, t, k1_z, k1_y, statistics);                   // k₁ = f(z⁽ᵏ⁾, tₖ)
+    joint_rates(system, Z(z + half * k1_z), Y(y + half * k1_y), t + half, k2_z, k2_y,
+                statistics);                                                // k₂ = f(z⁽ᵏ⁾ + h/2 k₁, tₖ + h/2)
+    joint_rates(system, Z(z + half * k2_z), Y(y + half * k2_y), t + half, k3_z, k3_y,
+                statistics);                                                // k₃ = f(z⁽ᵏ⁾ + h/2 k₂, tₖ + h/2)
+    joint_rates(system, Z(z + h * k3_z), Y(y + h * k3_y), t + h, k4_z, k4_y,
+                statistics);                                                // k₄ = f(z⁽ᵏ⁾ + h k₃, tₖ + h)
     z += (h / 6.0) * (k1_z + 2.0 * k2_z + 2.0 * k3_z + k4_z);  // z⁽ᵏ⁺¹⁾ ← z⁽ᵏ⁾ + h/6 (k₁ + 2k₂ + 2k₃ + k₄)
     y += (h / 6.0) * (k1_y + 2.0 * k2_y + 2.0 * k3_y + k4_y);  // y⁽ᵏ⁺¹⁾ ← y⁽ᵏ⁾ + h/6 (g₁ + 2g₂ + 2g₃ + g₄)
   }

@@ -1,0 +1,144 @@
+// The integrator registry: wraps a generic stepper (runge_kutta.h, dopri5.h, implicit_midpoint.h,
+// birkhoff_symplectic.h) and one of the cart's Birkhoffian systems (cart_birkhoffian.h) into the
+// type-erased CartStepper the simulation uses.
+#include "birkhoff_cart/core/integrators/cart_stepper.h"
+
+#include <cmath>
+#include <functional>
+#include <sstream>
+#include <stdexcept>
+
+#include "birkhoff_cart/core/cart_birkhoffian.h"
+#include "birkhoff_cart/core/integrators/birkhoff_symplectic.h"
+#include "birkhoff_cart/core/integrators/dopri5.h"
+#include "birkhoff_cart/core/integrators/implicit_midpoint.h"
+#include "birkhoff_cart/core/integrators/runge_kutta.h"
+
+namespace birkhoff_cart {
+namespace {
+
+const char* const kBirkhoffianNames[kBirkhoffianSize] = {"arc_length pi1", "steering_angle chi",
+                                                        "forward momentum p1", "steering momentum p2"};
+const char* const kPassiveNames[kPassiveSize] = {"x",
+                                                 "y",
+                                                 "heading theta",
+                                                 "wheel_spin_angle phi1",
+                                                 "wheel_spin_angle phi2",
+                                                 "wheel_spin_angle phi3",
+                                                 "wheel_spin_angle phi4",
+                                                 "applied_work W",
+                                                 "steering_impulse I2"};
+
+void require_valid_step_size(double step_size) {
+  if (!(step_size > 0.0) || !std::isfinite(step_size)) {
+    std::ostringstream message;
+    message << "step size must be finite and > 0 s, got " << step_size;
+    throw std::invalid_argument(message.str());
+  }
+}
+
+[[noreturn]] void throw_non_finite(const std::string& integrator, double time, double step_size,
+                                   const std::string& quantity, double value) {
+  std::ostringstream message;
+  message.precision(17);
+  message << integrator << " step from t = " << time << " s (h = " << step_size << " s) produced a non-finite "
+          << quantity << " (" << value << ")";
+  throw StepError(message.str());
+}
+
+/// Generic stepper + cart system → CartStepper. Transactional: the state, the statistics and the
+/// stepper's own memory (dopri5's step-size guess) change only when the whole step succeeded.
+template <class Stepper, class System>
+class CartStepperAdapter final : public CartStepper {
+ public:
+  CartStepperAdapter(const Stepper& stepper, const CartModel& model, const EffectSet& effects)
+      : stepper_(stepper), system_(model, effects), name_(Stepper::name()) {}
+
+  const std::string& name() const override { return name_; }
+  int order() const override { return Stepper::kOrder; }
+  bool symmetric() const override { return Stepper::kSymmetric; }
+
+  void step(CartState& state, double step_size, StepStatistics& statistics) override {
+    require_valid_step_size(step_size);
+    const double time = state.time;  // tₖ [s]
+    system_.begin_step(time);        // rep (a): structure epoch tₑ = tₖ; rep (b): nothing
+    CartBirkhoffianPoint point = system_.to_birkhoffian(state);
+    Stepper trial = stepper_;
+    StepStatistics counted = statistics;
+    try {
+      trial.step(system_, point.z, point.y, time, step_size, counted);
+    } catch (const StepError& error) {
+      throw StepError(name_ + ": " + error.what());
+    }
+    for (int i = 0; i < kBirkhoffianSize; ++i) {
+      if (!std::isfinite(point.z(i))) throw_non_finite(name_, time, step_size, kBirkhoffianNames[i], point.z(i));
+    }
+    for (int i = 0; i < kPassiveSize; ++i) {
+      if (!std::isfinite(point.y(i))) throw_non_finite(name_, time, step_size, kPassiveNames[i], point.y(i));
+    }
+    const CartState next = system_.to_cart_state(point.z, point.y, time + step_size);
+    if (!std::isfinite(next.forward_speed)) {
+      throw_non_finite(name_, time, step_size, "forward_speed omega1 (singular mass matrix?)", next.forward_speed);
+    }
+    if (!std::isfinite(next.steering_rate)) {
+      throw_non_finite(name_, time, step_size, "steering_rate omega2 (singular mass matrix?)", next.steering_rate);
+    }
+    ++counted.steps;
+    state = next;
+    statistics = counted;
+    stepper_ = trial;
+  }
+
+ private:
+  Stepper stepper_;
+  System system_;
+  std::string name_;
+};
+
+template <class Stepper>
+std::unique_ptr<CartStepper> wrap(const Stepper& stepper, const IntegratorSettings& settings, const CartModel& model,
+                                  const EffectSet& effects) {
+  if (settings.birkhoffian_form == "autonomous") {
+    return std::make_unique<CartStepperAdapter<Stepper, CartAutonomousBirkhoffian>>(stepper, model, effects);
+  }
+  if (settings.birkhoffian_form == "paper") {
+    return std::make_unique<CartStepperAdapter<Stepper, CartPaperBirkhoffian>>(stepper, model, effects);
+  }
+  throw std::invalid_argument("unknown birkhoffian_form '" + settings.birkhoffian_form +
+                              "' (known: autonomous, paper)");
+}
+
+std::string known_names() {
+  std::string list;
+  for (const std::string& name : integrator_names()) list += (list.empty() ? "" : ", ") + name;
+  return list;
+}
+
+}  // namespace
+
+std::vector<std::string> integrator_names() { return {"birkhoff2", "birkhoff4", "rk2", "rk4", "dopri5", "midpoint"}; }
+
+std::unique_ptr<CartStepper> make_cart_stepper(const IntegratorSettings& settings, const CartModel& model,
+                                               const EffectSet& effects) {
+  require_valid_step_size(settings.step_size);
+  if (settings.max_newton_iterations < 1) {
+    throw std::invalid_argument("max_newton_iterations must be >= 1, got " +
+                                std::to_string(settings.max_newton_iterations));
+  }
+  if (!(settings.newton_tolerance > 0.0) || !std::isfinite(settings.newton_tolerance)) {
+    throw std::invalid_argument("newton_tolerance must be finite and > 0");
+  }
+  NewtonSettings newton;
+  newton.tolerance = settings.newton_tolerance;
+  newton.max_iterations = settings.max_newton_iterations;
+  const std::string& name = settings.name;
+  if (name == "birkhoff2") return wrap(BirkhoffSymplectic2(newton), settings, model, effects);
+  if (name == "birkhoff4") return wrap(BirkhoffSymplectic4(newton), settings, model, effects);
+  if (name == "rk2") return wrap(HeunRungeKutta2(), settings, model, effects);
+  if (name == "rk4") return wrap(ClassicalRungeKutta4(), settings, model, effects);
+  if (name == "dopri5") return wrap(DormandPrince5(settings.tolerance), settings, model, effects);
+  if (name == "midpoint") return wrap(ImplicitMidpoint(newton), settings, model, effects);
+  throw std::invalid_argument("unknown integrator '" + name + "' (known: " + known_names() + ")");
+}
+
+}  // namespace birkhoff_cart
