@@ -8,9 +8,12 @@
 #include <cmath>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "birkhoff_cart/core/autodiff.h"
 #include "birkhoff_cart/core/birkhoffian_system.h"
+#include "birkhoff_cart/core/cart_birkhoffian.h"
+#include "birkhoff_cart/core/effect_library.h"
 #include "birkhoff_cart/core/integrators/newton.h"
 #include "test_systems.h"
 
@@ -149,6 +152,41 @@ TEST(TestSystems, CubicChartExactSolutionSolvesTheEquations) {
   const Eigen::Vector2d rate = birkhoffian_rates(system, system.exact(t0, z0, t), t);
   const Eigen::Vector2d difference = (system.exact(t0, z0, t + dt) - system.exact(t0, z0, t - dt)) / (2 * dt);
   EXPECT_LE((difference - rate).norm(), 1e-8);
+}
+
+TEST(CartSystems, StructureAndChartMatchAutomaticDifferentiation) {
+  // Both representations, with loads on (Λ ≠ 0) and off, on the physical cart and the paper's case.
+  std::vector<EffectSpec> specs(3);
+  specs[0].name = "steering_torque";
+  specs[0].profile.kind = TorqueProfile::Kind::kCosine;
+  specs[0].profile.amplitude = 2.0;  // [N·m]
+  specs[0].profile.frequency = 0.5;  // [Hz]
+  specs[1].name = "air_drag";
+  specs[1].coefficients = {{"coefficient", 0.4}};
+  specs[2].name = "steering_damping";
+  specs[2].coefficients = {{"coefficient", 1.5}};
+  CartParameters paper_parameters;
+  paper_parameters.wheelbase = 1.0;
+  for (const CartModel& model : {CartModel(CartParameters{}), CartModel(paper_parameters, InertiaModel::kPaperSpecialCase)}) {
+    const EffectSet effects = build_effects(specs, model);
+    std::mt19937 random(3);
+    std::uniform_real_distribution<double> uniform(-1.2, 1.2);
+    for (bool enabled : {true, false}) {
+      CartAutonomousBirkhoffian autonomous(model, effects);
+      CartPaperBirkhoffian paper(model, effects);
+      autonomous.set_non_birkhoffian_force_enabled(enabled);
+      paper.set_non_birkhoffian_force_enabled(enabled);
+      for (int trial = 0; trial < 4; ++trial) {
+        const Eigen::Vector4d z(10.0 * uniform(random), uniform(random), 5.0 * uniform(random), uniform(random));
+        const double t = 4.0 + uniform(random);
+        paper.begin_step(t - 0.3 * uniform(random));
+        const std::string label = std::string(model.inertia_model() == InertiaModel::kPhysical ? "physical" : "paper") +
+                                  (enabled ? ", loads on" : ", Birkhoffian part");
+        check_structure_against_ad(autonomous, z, t, "cart (b), " + label);
+        check_structure_against_ad(paper, z, t, "cart (a), " + label);
+      }
+    }
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
