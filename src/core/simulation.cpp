@@ -1,0 +1,119 @@
+#include "birkhoff_cart/core/simulation.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "birkhoff_cart/core/effect_library.h"
+#include "birkhoff_cart/core/reference_solution.h"
+
+namespace birkhoff_cart {
+namespace {
+
+InertiaModel inertia_model_of(const Scene& scene) {
+  return scene.paper_special_case ? InertiaModel::kPaperSpecialCase : InertiaModel::kPhysical;
+}
+
+/// The initial command value of the scene's command-sourced effect `name` [N·m] (0 if none).
+double initial_command(const Scene& scene, const std::string& name) {
+  for (const EffectSpec& spec : scene.effects) {
+    if (spec.name == name && spec.profile.kind == TorqueProfile::Kind::kCommand) return spec.profile.value;
+  }
+  return 0.0;
+}
+
+void require_finite_torque(double torque, const char* which) {
+  if (!std::isfinite(torque)) {
+    std::ostringstream message;
+    message << which << " command must be a finite torque [N·m], got " << torque;
+    throw std::invalid_argument(message.str());
+  }
+}
+
+}  // namespace
+
+Simulation::Simulation(const Scene& scene)
+    : scene_(scene),
+      model_(scene.cart, inertia_model_of(scene)),
+      effects_(build_effects(scene.effects, model_)),
+      stepper_(make_cart_stepper(scene.integrator, model_, effects_)),
+      state_(scene.initial_state) {
+  if (!(scene_.duration > 0.0) || !std::isfinite(scene_.duration)) {
+    std::ostringstream message;
+    message << "scene duration must be finite and > 0 s, got " << scene_.duration;
+    throw std::invalid_argument(message.str());
+  }
+  initial_energy_ = model_.energy(state_);
+  initial_steering_momentum_ = model_.steering_momentum(state_);
+  reference_ = make_reference_solution(scene_, model_, effects_);
+}
+
+Simulation::~Simulation() = default;
+
+double Simulation::end_time() const { return scene_.initial_state.time + scene_.duration; }
+
+void Simulation::step() {
+  const double h = scene_.integrator.step_size;  // [s]
+  CartState next = state_;
+  StepStatistics statistics = statistics_;
+  stepper_->step(next, h, statistics);  // throws StepError; `next` is then discarded
+  // tₙ₊₁ = t₀ + (n+1) h exactly, not an accumulated sum of h.
+  next.time = scene_.initial_state.time + static_cast<double>(steps_taken_ + 1) * h;
+  if (reference_) reference_->step(next.time);  // transactional itself; throws before we commit
+  state_ = next;
+  statistics_ = statistics;
+  ++steps_taken_;
+}
+
+void Simulation::advance_to(double time) {
+  const double h = scene_.integrator.step_size;
+  while (state_.time + 0.5 * h <= time) step();
+}
+
+void Simulation::reset() {
+  stepper_ = make_cart_stepper(scene_.integrator, model_, effects_);  // forgets adaptive step-size guesses
+  state_ = scene_.initial_state;
+  steps_taken_ = 0;
+  statistics_ = StepStatistics{};
+  if (reference_) reference_->reset();
+  if (effects_.steering_command()) effects_.steering_command()->value = initial_command(scene_, "steering_torque");
+  if (effects_.drive_command()) effects_.drive_command()->value = initial_command(scene_, "drive_torque");
+}
+
+bool Simulation::accepts_steering_command() const { return static_cast<bool>(effects_.steering_command()); }
+bool Simulation::accepts_drive_command() const { return static_cast<bool>(effects_.drive_command()); }
+
+void Simulation::set_steering_command(double torque) {
+  if (!accepts_steering_command()) {
+    throw std::logic_error("scene '" + scene_.name + "' has no steering_torque effect with source 'command'");
+  }
+  require_finite_torque(torque, "steering");
+  effects_.steering_command()->value = torque;
+}
+
+void Simulation::set_drive_command(double torque) {
+  if (!accepts_drive_command()) {
+    throw std::logic_error("scene '" + scene_.name + "' has no drive_torque effect with source 'command'");
+  }
+  require_finite_torque(torque, "drive");
+  effects_.drive_command()->value = torque;
+}
+
+double Simulation::steering_command() const {
+  return effects_.steering_command() ? effects_.steering_command()->value : 0.0;
+}
+
+double Simulation::drive_command() const { return effects_.drive_command() ? effects_.drive_command()->value : 0.0; }
+
+Diagnostics Simulation::diagnostics() const {
+  Diagnostics diagnostics;
+  diagnostics.energy = model_.energy(state_);
+  // T* − T*₀ − ∫ω·Q dt (docs eq. (3.7)) and p2 − p2₀ − ∫Q2 dt (docs eq. (3.8))
+  diagnostics.energy_balance_residual = diagnostics.energy - initial_energy_ - state_.applied_work;
+  diagnostics.p2_balance_residual = model_.steering_momentum(state_) - initial_steering_momentum_ - state_.steering_impulse;
+  diagnostics.max_constraint_residual = model_.max_constraint_residual(state_);
+  if (reference_) reference_->compare(state_, diagnostics);
+  return diagnostics;
+}
+
+}  // namespace birkhoff_cart
