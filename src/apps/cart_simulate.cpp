@@ -1,0 +1,189 @@
+// cart_simulate: runs a scene in batch and writes the trajectory as CSV (no ROS master needed).
+//
+//   cart_simulate --scene FILE [--integrator NAME] [--step H] [--tolerance TOL] [--duration T]
+//                 [--output-rate HZ] [--birkhoffian-form F] --output FILE.csv
+//
+// Columns: t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2 (SI units; energy is T*
+// [J], p2 the front axle's yaw momentum [kg·m²/s]); one row per output instant t0 + k/HZ from the
+// start to the end, both included; values printed with %.17g (round-trip exact).
+// Exit status: 0 done; 2 bad arguments (usage on stderr); 3 unusable scene or settings;
+// 4 a step failed (the rows written so far are kept).
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/simulation.h"
+
+namespace {
+
+using birkhoff_cart::CartState;
+using birkhoff_cart::Scene;
+using birkhoff_cart::Simulation;
+
+constexpr int kExitUsage = 2;
+constexpr int kExitSettings = 3;
+constexpr int kExitStepFailed = 4;
+constexpr double kCommensurabilityTolerance = 1e-9;  // relative, for "1/HZ is a multiple of h" [-]
+
+const char* const kUsage =
+    "usage: cart_simulate --scene FILE [--integrator NAME] [--step H] [--tolerance TOL]\n"
+    "                     [--duration T] [--output-rate HZ] [--birkhoffian-form F] --output FILE.csv\n"
+    "  --scene FILE            scene YAML (config/scenes/*.yaml); it provides every default\n"
+    "  --integrator NAME       birkhoff2, birkhoff4, rk2, rk4, dopri5 or midpoint\n"
+    "  --step H                step size [s], > 0; 1/HZ must be a whole multiple of it\n"
+    "  --tolerance TOL         dopri5 absolute and relative tolerance [-], > 0\n"
+    "  --duration T            simulated time after the start [s], > 0\n"
+    "  --output-rate HZ        output rows per simulated second [Hz], > 0\n"
+    "  --birkhoffian-form F    autonomous or paper\n"
+    "  --output FILE.csv       where to write t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2\n"
+    "The rows are at t0 + k/HZ from the start to the end; when the duration is not a whole number\n"
+    "of output intervals, the run stops at the last output instant before the end (with a note).\n";
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+double parse_positive(const std::string& option, const std::string& text) {
+  errno = 0;
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || !std::isfinite(value) || !(value > 0.0)) {
+    throw UsageError("option " + option + " needs a finite number > 0, got '" + text + "'");
+  }
+  return value;
+}
+
+std::map<std::string, std::string> parse_arguments(int argc, char** argv) {
+  static const char* const kOptions[] = {"--scene",       "--integrator",       "--step",  "--tolerance",
+                                         "--duration",    "--output-rate",      "--birkhoffian-form", "--output"};
+  std::map<std::string, std::string> values;
+  for (int i = 1; i < argc; ++i) {
+    const std::string option = argv[i];
+    bool known = false;
+    for (const char* candidate : kOptions) known = known || option == candidate;
+    if (!known) throw UsageError("unknown argument '" + option + "'");
+    if (i + 1 >= argc) throw UsageError("option " + option + " needs a value");
+    if (values.count(option)) throw UsageError("option " + option + " given twice");
+    values[option] = argv[++i];
+  }
+  if (!values.count("--scene")) throw UsageError("missing --scene FILE");
+  if (!values.count("--output")) throw UsageError("missing --output FILE.csv");
+  return values;
+}
+
+/// Applies the command-line overrides to the scene's settings.
+void apply_overrides(const std::map<std::string, std::string>& arguments, Scene& scene) {
+  for (const auto& [option, text] : arguments) {
+    if (option == "--integrator") scene.integrator.name = text;
+    if (option == "--step") scene.integrator.step_size = parse_positive(option, text);
+    if (option == "--tolerance") scene.integrator.tolerance = parse_positive(option, text);
+    if (option == "--duration") scene.duration = parse_positive(option, text);
+    if (option == "--output-rate") scene.output_rate = parse_positive(option, text);
+    if (option == "--birkhoffian-form") {
+      if (text != "autonomous" && text != "paper") {
+        throw UsageError("option --birkhoffian-form must be 'autonomous' or 'paper', got '" + text + "'");
+      }
+      scene.integrator.birkhoffian_form = text;
+    }
+  }
+}
+
+/// n such that 1/HZ = n h, or an error when there is no such whole number.
+long steps_per_output(const Scene& scene) {
+  const double ratio = 1.0 / (scene.output_rate * scene.integrator.step_size);
+  const long steps = std::lround(ratio);
+  if (steps < 1 || std::abs(ratio - static_cast<double>(steps)) > kCommensurabilityTolerance * ratio) {
+    char message[256];
+    std::snprintf(message, sizeof message,
+                  "the output interval 1/%.17g s is not a whole number of steps of %.17g s (ratio %.17g)",
+                  scene.output_rate, scene.integrator.step_size, ratio);
+    throw std::invalid_argument(message);
+  }
+  return steps;
+}
+
+void write_row(std::FILE* file, double time, const CartState& state, double energy, double steering_momentum) {
+  std::fprintf(file, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", time,
+               state.x, state.y, state.heading, state.steering_angle, state.wheel_spin_angle[0],
+               state.wheel_spin_angle[1], state.wheel_spin_angle[2], state.wheel_spin_angle[3], state.arc_length,
+               state.forward_speed, state.steering_rate, energy, steering_momentum);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::map<std::string, std::string> arguments;
+  Scene scene;
+  try {
+    arguments = parse_arguments(argc, argv);
+    scene = birkhoff_cart::load_scene(arguments.at("--scene"));
+    apply_overrides(arguments, scene);
+  } catch (const UsageError& error) {
+    std::fprintf(stderr, "cart_simulate: %s\n%s", error.what(), kUsage);
+    return kExitUsage;
+  } catch (const birkhoff_cart::SceneError& error) {
+    std::fprintf(stderr, "cart_simulate: %s\n", error.what());
+    return kExitSettings;
+  }
+
+  std::unique_ptr<Simulation> simulation;
+  long steps_between_rows = 0;
+  long output_intervals = 0;
+  try {
+    simulation = std::make_unique<Simulation>(scene);
+    steps_between_rows = steps_per_output(scene);
+    const double intervals = scene.duration * scene.output_rate;
+    output_intervals = static_cast<long>(std::floor(intervals * (1.0 + kCommensurabilityTolerance)));
+    if (std::abs(intervals - static_cast<double>(output_intervals)) > kCommensurabilityTolerance * intervals) {
+      std::fprintf(stderr,
+                   "cart_simulate: note: duration %.17g s is not a whole number of output intervals; the run "
+                   "stops at t0 + %ld/%.17g s\n",
+                   scene.duration, output_intervals, scene.output_rate);
+    }
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "cart_simulate: %s\n", error.what());
+    return kExitSettings;
+  }
+
+  const std::string output_path = arguments.at("--output");
+  std::FILE* file = std::fopen(output_path.c_str(), "w");
+  if (!file) {
+    std::fprintf(stderr, "cart_simulate: cannot write '%s': %s\n", output_path.c_str(), std::strerror(errno));
+    return kExitSettings;
+  }
+  std::fprintf(file, "t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2\n");
+  const double start_time = scene.initial_state.time;  // t0 [s]
+  const birkhoff_cart::CartModel& model = simulation->model();
+  long rows = 0;
+  try {
+    for (long k = 0; k <= output_intervals; ++k) {
+      if (k > 0) {
+        for (long n = 0; n < steps_between_rows; ++n) simulation->step();
+      }
+      const CartState& state = simulation->state();
+      write_row(file, start_time + static_cast<double>(k) / scene.output_rate, state, model.energy(state),
+                model.steering_momentum(state));
+      ++rows;
+    }
+  } catch (const birkhoff_cart::StepError& error) {
+    std::fflush(file);
+    std::fclose(file);
+    std::fprintf(stderr, "cart_simulate: step failed after t = %.17g s (%ld rows written to %s): %s\n",
+                 simulation->state().time, rows, output_path.c_str(), error.what());
+    return kExitStepFailed;
+  }
+  if (std::fclose(file) != 0) {
+    std::fprintf(stderr, "cart_simulate: error writing '%s': %s\n", output_path.c_str(), std::strerror(errno));
+    return kExitSettings;
+  }
+  return 0;
+}

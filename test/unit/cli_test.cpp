@@ -1,0 +1,211 @@
+// cart_simulate, the batch CLI, run as a separate process (it lives next to this test binary in
+// devel/lib/birkhoff_cart/): CSV format, row times, numbers identical to an in-process Simulation
+// run, and its error paths (usage, unknown integrator, scene errors, a failing step).
+#include <gtest/gtest.h>
+#include <limits.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/simulation.h"
+
+namespace birkhoff_cart {
+namespace {
+
+const char* const kHeader = "t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2";
+
+std::string scene_path(const std::string& name) {
+  return std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/" + name + ".yaml";
+}
+
+/// devel/lib/birkhoff_cart/cart_simulate, found from this test's own executable.
+std::string cli_path() {
+  char buffer[PATH_MAX];
+  const ssize_t length = readlink("/proc/self/exe", buffer, sizeof(buffer) - 1);
+  if (length <= 0) return "cart_simulate";
+  std::string self(buffer, static_cast<std::size_t>(length));
+  return self.substr(0, self.find_last_of('/')) + "/cart_simulate";
+}
+
+struct Outcome {
+  int exit_status = -1;
+  std::string error_output;
+};
+
+std::string temp_path(const std::string& name) {
+  return ::testing::TempDir() + "cli_test_" + std::to_string(getpid()) + "_" + name;
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream file(path);
+  std::stringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
+Outcome run_cli(const std::string& arguments) {
+  const std::string stderr_path = temp_path("stderr.txt");
+  const std::string command = "'" + cli_path() + "' " + arguments + " 2> '" + stderr_path + "'";
+  const int status = std::system(command.c_str());
+  Outcome outcome;
+  outcome.exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  outcome.error_output = read_file(stderr_path);
+  std::remove(stderr_path.c_str());
+  return outcome;
+}
+
+std::vector<std::string> read_lines(const std::string& path) {
+  std::ifstream file(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(file, line);) lines.push_back(line);
+  return lines;
+}
+
+std::vector<double> parse_row(const std::string& line) {
+  std::vector<double> values;
+  std::stringstream stream(line);
+  for (std::string field; std::getline(stream, field, ',');) values.push_back(std::strtod(field.c_str(), nullptr));
+  return values;
+}
+
+/// The row the CLI must write for `state` at output instant `time`.
+std::vector<double> expected_row(double time, const Simulation& simulation) {
+  const CartState& s = simulation.state();
+  return {time,
+          s.x,
+          s.y,
+          s.heading,
+          s.steering_angle,
+          s.wheel_spin_angle[0],
+          s.wheel_spin_angle[1],
+          s.wheel_spin_angle[2],
+          s.wheel_spin_angle[3],
+          s.arc_length,
+          s.forward_speed,
+          s.steering_rate,
+          simulation.model().energy(s),
+          simulation.model().steering_momentum(s)};
+}
+
+/// Runs the scene in-process and compares every CSV row with it, bit for bit.
+void expect_matches_simulation(const Scene& scene, const std::vector<std::string>& lines, int expected_rows) {
+  ASSERT_EQ(static_cast<int>(lines.size()), expected_rows + 1);
+  EXPECT_EQ(lines[0], kHeader);
+  Simulation simulation(scene);
+  const long steps_per_row = std::lround(1.0 / (scene.output_rate * scene.integrator.step_size));
+  for (int k = 0; k < expected_rows; ++k) {
+    if (k > 0) {
+      for (long n = 0; n < steps_per_row; ++n) simulation.step();
+    }
+    const double time = scene.initial_state.time + static_cast<double>(k) / scene.output_rate;
+    const std::vector<double> row = parse_row(lines[k + 1]);
+    const std::vector<double> expected = expected_row(time, simulation);
+    ASSERT_EQ(row.size(), expected.size()) << "row " << k;
+    for (std::size_t column = 0; column < row.size(); ++column) {
+      ASSERT_EQ(row[column], expected[column]) << "row " << k << " column " << column;  // %.17g round-trips
+    }
+  }
+}
+
+TEST(CartSimulate, FreeCoastCsvMatchesASimulationRunBitForBit) {
+  const std::string output = temp_path("free_coast.csv");
+  const Outcome outcome = run_cli("--scene '" + scene_path("free_coast") + "' --output '" + output + "'");
+  ASSERT_EQ(outcome.exit_status, 0) << outcome.error_output;
+  const std::vector<std::string> lines = read_lines(output);
+  const Scene scene = load_scene(scene_path("free_coast"));  // 6 s at 100 Hz: 601 rows
+  ASSERT_EQ(lines.size(), 602u);
+  EXPECT_EQ(parse_row(lines[1])[0], 0.0);
+  EXPECT_EQ(parse_row(lines.back())[0], 6.0);
+  expect_matches_simulation(scene, lines, 601);
+  std::remove(output.c_str());
+}
+
+TEST(CartSimulate, CommandLineOverridesTheScene) {
+  const std::string output = temp_path("overrides.csv");
+  const Outcome outcome =
+      run_cli("--scene '" + scene_path("free_coast") +
+              "' --integrator rk4 --step 2e-3 --output-rate 50 --duration 1 --birkhoffian-form paper --output '" +
+              output + "'");
+  ASSERT_EQ(outcome.exit_status, 0) << outcome.error_output;
+  Scene scene = load_scene(scene_path("free_coast"));
+  scene.integrator.name = "rk4";
+  scene.integrator.step_size = 2e-3;
+  scene.integrator.birkhoffian_form = "paper";
+  scene.output_rate = 50.0;
+  scene.duration = 1.0;
+  const std::vector<std::string> lines = read_lines(output);
+  EXPECT_EQ(parse_row(lines.back())[0], 1.0);
+  expect_matches_simulation(scene, lines, 51);
+  std::remove(output.c_str());
+}
+
+TEST(CartSimulate, BadArgumentsExitNonZeroWithUsage) {
+  const std::string scene = "--scene '" + scene_path("free_coast") + "'";
+  const std::string output = "--output '" + temp_path("never.csv") + "'";
+  const std::string both = scene + " " + output;
+  const std::vector<std::string> bad_arguments = {
+      "", scene, output, both + " --frobnicate 1", both + " --step abc", both + " --step 0",
+      both + " --duration -2", both + " --step", both + " --birkhoffian-form lagrangian"};
+  for (const std::string& arguments : bad_arguments) {
+    const Outcome outcome = run_cli(arguments);
+    EXPECT_NE(outcome.exit_status, 0) << arguments;
+    EXPECT_NE(outcome.error_output.find("usage: cart_simulate"), std::string::npos) << arguments;
+  }
+}
+
+TEST(CartSimulate, UnknownIntegratorNamesTheKnownOnes) {
+  const Outcome outcome = run_cli("--scene '" + scene_path("free_coast") + "' --integrator euler --output '" +
+                                  temp_path("never.csv") + "'");
+  EXPECT_NE(outcome.exit_status, 0);
+  for (const char* name : {"euler", "birkhoff2", "birkhoff4", "rk2", "rk4", "dopri5", "midpoint"}) {
+    EXPECT_NE(outcome.error_output.find(name), std::string::npos) << outcome.error_output;
+  }
+}
+
+TEST(CartSimulate, SceneErrorIsOneLineNamingTheFile) {
+  const std::string missing = temp_path("no_such_scene.yaml");
+  const Outcome outcome = run_cli("--scene '" + missing + "' --output '" + temp_path("never.csv") + "'");
+  EXPECT_NE(outcome.exit_status, 0);
+  EXPECT_NE(outcome.error_output.find(missing), std::string::npos) << outcome.error_output;
+  EXPECT_EQ(outcome.error_output.find('\n'), outcome.error_output.size() - 1) << outcome.error_output;
+}
+
+TEST(CartSimulate, OutputIntervalMustBeWholeSteps) {
+  const Outcome outcome = run_cli("--scene '" + scene_path("free_coast") + "' --step 3e-3 --output '" +
+                                  temp_path("never.csv") + "'");
+  EXPECT_NE(outcome.exit_status, 0);
+  EXPECT_NE(outcome.error_output.find("not a whole number of steps"), std::string::npos) << outcome.error_output;
+}
+
+TEST(CartSimulate, FailingStepKeepsTheRowsWrittenAndNamesTheTime) {
+  // The paper's special case started on χ = 0, where its mass matrix is singular: the first step
+  // fails after the initial row was written.
+  std::string text = read_file(scene_path("paper_special"));
+  const std::string steering = "steering_angle: 1.5707963267948966";
+  const std::string reference = "kind: paper_analytic";
+  ASSERT_NE(text.find(steering), std::string::npos);
+  ASSERT_NE(text.find(reference), std::string::npos);
+  text.replace(text.find(steering), steering.size(), "steering_angle: 0.0");
+  text.replace(text.find(reference), reference.size(), "kind: none");
+  const std::string broken_scene = temp_path("singular.yaml");
+  std::ofstream(broken_scene) << text;
+  const std::string output = temp_path("singular.csv");
+  const Outcome outcome = run_cli("--scene '" + broken_scene + "' --output '" + output + "'");
+  EXPECT_NE(outcome.exit_status, 0);
+  EXPECT_NE(outcome.error_output.find("t = 1.5707963267948966"), std::string::npos) << outcome.error_output;
+  const std::vector<std::string> lines = read_lines(output);
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[0], kHeader);
+  EXPECT_EQ(parse_row(lines[1])[0], 1.5707963267948966);
+  std::remove(output.c_str());
+  std::remove(broken_scene.c_str());
+}
+
+}  // namespace
+}  // namespace birkhoff_cart
