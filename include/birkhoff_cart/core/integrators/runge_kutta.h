@@ -45,7 +45,7 @@ void joint_rates(const System& system, const StateVector<System, S>& z, const Pa
 /// variant. We take Heun's method because it is what Chinese numerical-analysis textbooks call
 /// 二阶龙格–库塔 / 改进欧拉法 (the improved Euler method), the paper's likely meaning; both common
 /// 2-stage variants (Heun, explicit midpoint) have the same order and the same non-symmetric,
-/// non-symplectic character, which is all the comparison relies on. (docs/integrators.md note.)
+/// non-symplectic character, which is all the comparison relies on.
 struct HeunRungeKutta2 {
   static constexpr int kOrder = 2;
   static constexpr bool kSymmetric = false;
