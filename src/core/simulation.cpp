@@ -6,6 +6,7 @@
 
 #include "birkhoff_cart/core/effect_library.h"
 #include "birkhoff_cart/core/reference_solution.h"
+#include "birkhoff_cart/core/singular_steering.h"
 
 namespace birkhoff_cart {
 namespace {
@@ -56,7 +57,9 @@ void Simulation::step() {
   const double h = scene_.integrator.step_size;  // [s]
   CartState next = state_;
   StepStatistics statistics = statistics_;
+  check_singular_steering(model_, state_, h);  // paper case: refuse a step onto χ = kπ (docs/hard_cases.md §1)
   stepper_->step(next, h, statistics);  // throws StepError; `next` is then discarded
+  check_singular_steering(model_, state_, h, &next);
   // tₙ₊₁ = t₀ + (n+1) h exactly, not an accumulated sum of h.
   next.time = scene_.initial_state.time + static_cast<double>(steps_taken_ + 1) * h;
   if (reference_) reference_->step(next.time);  // transactional itself; throws before we commit
