@@ -6,11 +6,12 @@
 int main(int argc, char** argv) {
   ros::init(argc, argv, "cart_sim", ros::init_options::NoSigintHandler);
   birkhoff_cart::install_shutdown_signal_handlers();
+  // Outlives the node: when the last NodeHandle dies roscpp shuts down and drops later log output,
+  // so the FATAL message below would be lost.
+  ros::NodeHandle node_handle;
   try {
-    birkhoff_cart::CartSimNode node(ros::NodeHandle(), ros::NodeHandle("~"));
-    const int exit_code = node.run();
-    ros::shutdown();
-    return exit_code;
+    birkhoff_cart::CartSimNode node(node_handle, ros::NodeHandle("~"));
+    return node.run();
   } catch (const birkhoff_cart::NodeStartupError& error) {
     ROS_FATAL("cart_sim: %s", error.what());
     return 2;
