@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Work–precision benchmark (issue 6; docs/benchmarks.md): build, run the ROS-free work_precision
+# executable from the repository, then plot and tabulate with Debian's python3-matplotlib.
+#
+# Usage: scripts/run_benchmark.sh [--quick] [more work_precision options]
+#   default: ~10 minutes on a quiet 2-core machine; writes bench/results/*.csv, *.png, work_precision.md
+#   --quick: ~5 s smoke run (3 repetitions, jackknife_whirl 100 s, fewer step sizes) into
+#            /tmp/birkhoff_cart_bench_quick unless --output-dir is given
+# Environment: BIRKHOFF_CART_WORKSPACE = an already-built catkin workspace to use instead of
+#              running scripts/setup.sh (which builds .ws/).
+set -euo pipefail
+repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+export PATH="/usr/bin:/bin:$PATH"
+
+workspace="${BIRKHOFF_CART_WORKSPACE:-}"
+if [ -z "$workspace" ]; then
+  "$repo/scripts/setup.sh"
+  workspace="$repo/.ws"
+fi
+binary="$workspace/devel/lib/birkhoff_cart/work_precision"
+if [ ! -x "$binary" ]; then
+  echo "run_benchmark.sh: $binary not built" >&2
+  exit 1
+fi
+
+output_dir="$repo/bench/results"
+arguments=("$@")
+for argument in "$@"; do
+  if [ "$argument" = "--quick" ]; then output_dir=/tmp/birkhoff_cart_bench_quick; fi
+done
+for ((i = 0; i < ${#arguments[@]}; ++i)); do
+  if [ "${arguments[$i]}" = "--output-dir" ]; then output_dir="${arguments[$((i + 1))]}"; fi
+done
+mkdir -p "$output_dir"
+
+cd "$repo"
+echo "load before: $(cat /proc/loadavg)"
+"$binary" --output-dir "$output_dir" "$@"
+echo "load after:  $(cat /proc/loadavg)"
+/usr/bin/python3 "$repo/bench/bench_plot.py" "$output_dir"
