@@ -8,6 +8,7 @@
 // start to the end, both included; values printed with %.17g (round-trip exact).
 // Exit status: 0 done; 2 bad arguments (usage on stderr); 3 unusable scene or settings;
 // 4 a step failed (the rows written so far are kept).
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -45,8 +46,9 @@ const char* const kUsage =
     "  --output-rate HZ        output rows per simulated second [Hz], > 0\n"
     "  --birkhoffian-form F    autonomous or paper\n"
     "  --output FILE.csv       where to write t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2\n"
-    "The rows are at t0 + k/HZ from the start to the end; when the duration is not a whole number\n"
-    "of output intervals, the run stops at the last output instant before the end (with a note).\n";
+    "The rows are at t0 + k/HZ from the start to the end, both included; when the duration is not a\n"
+    "whole number of output intervals, a last row is written at the end time t0 + T itself (reached\n"
+    "by one shorter final step).\n";
 
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -138,17 +140,14 @@ int main(int argc, char** argv) {
   std::unique_ptr<Simulation> simulation;
   long steps_between_rows = 0;
   long output_intervals = 0;
+  bool ends_off_grid = false;  // the end time t0 + duration is not on the 1/HZ grid
   try {
     simulation = std::make_unique<Simulation>(scene);
     steps_between_rows = steps_per_output(scene);
     const double intervals = scene.duration * scene.output_rate;
     output_intervals = static_cast<long>(std::floor(intervals * (1.0 + kCommensurabilityTolerance)));
-    if (std::abs(intervals - static_cast<double>(output_intervals)) > kCommensurabilityTolerance * intervals) {
-      std::fprintf(stderr,
-                   "cart_simulate: note: duration %.17g s is not a whole number of output intervals; the run "
-                   "stops at t0 + %ld/%.17g s\n",
-                   scene.duration, output_intervals, scene.output_rate);
-    }
+    ends_off_grid =
+        std::abs(intervals - static_cast<double>(output_intervals)) > kCommensurabilityTolerance * intervals;
   } catch (const std::exception& error) {
     std::fprintf(stderr, "cart_simulate: %s\n", error.what());
     return kExitSettings;
@@ -172,6 +171,19 @@ int main(int argc, char** argv) {
       const CartState& state = simulation->state();
       write_row(file, start_time + static_cast<double>(k) / scene.output_rate, state, model.energy(state),
                 model.steering_momentum(state));
+      ++rows;
+    }
+    if (ends_off_grid) {
+      // The last row is at the end time itself: whole steps while they fit, then one shorter
+      // final step that lands on t0 + duration (the paper's case runs from π/2 to 3.0).
+      const double end_time = simulation->end_time();  // [s]
+      const double h = scene.integrator.step_size;     // [s]
+      while (simulation->state().time + h * (1.0 + kCommensurabilityTolerance) <= end_time) simulation->step();
+      if (end_time - simulation->state().time > kCommensurabilityTolerance * std::max(1.0, std::abs(end_time))) {
+        simulation->step_to(end_time);
+      }
+      const CartState& state = simulation->state();
+      write_row(file, end_time, state, model.energy(state), model.steering_momentum(state));
       ++rows;
     }
   } catch (const birkhoff_cart::StepError& error) {

@@ -54,14 +54,34 @@ Simulation::~Simulation() = default;
 double Simulation::end_time() const { return scene_.initial_state.time + scene_.duration; }
 
 void Simulation::step() {
+  if (finished_off_grid_) {
+    throw std::logic_error("scene '" + scene_.name + "' already ended off the step grid at t = " +
+                           std::to_string(state_.time) + " s; reset() before stepping again");
+  }
   const double h = scene_.integrator.step_size;  // [s]
+  // tₙ₊₁ = t₀ + (n+1) h exactly, not an accumulated sum of h.
+  take_step(h, scene_.initial_state.time + static_cast<double>(steps_taken_ + 1) * h);
+}
+
+void Simulation::step_to(double time) {
+  const double remaining = time - state_.time;  // [s]
+  if (!std::isfinite(time) || !(remaining > 0.0) || remaining > scene_.integrator.step_size * (1.0 + 1e-12)) {
+    std::ostringstream message;
+    message << "step_to(" << time << " s) from t = " << state_.time << " s needs 0 < t − tₙ ≤ h = "
+            << scene_.integrator.step_size << " s";
+    throw std::invalid_argument(message.str());
+  }
+  take_step(remaining, time);
+  finished_off_grid_ = true;
+}
+
+void Simulation::take_step(double h, double next_time) {
   CartState next = state_;
   StepStatistics statistics = statistics_;
   check_singular_steering(model_, state_, h);  // paper case: refuse a step onto χ = kπ (docs/hard_cases.md §1)
-  stepper_->step(next, h, statistics);  // throws StepError; `next` is then discarded
+  stepper_->step(next, h, statistics);         // throws StepError; `next` is then discarded
   check_singular_steering(model_, state_, h, &next);
-  // tₙ₊₁ = t₀ + (n+1) h exactly, not an accumulated sum of h.
-  next.time = scene_.initial_state.time + static_cast<double>(steps_taken_ + 1) * h;
+  next.time = next_time;
   if (reference_) reference_->step(next.time);  // transactional itself; throws before we commit
   state_ = next;
   statistics_ = statistics;
@@ -77,6 +97,7 @@ void Simulation::reset() {
   stepper_ = make_cart_stepper(scene_.integrator, model_, effects_);  // forgets adaptive step-size guesses
   state_ = scene_.initial_state;
   steps_taken_ = 0;
+  finished_off_grid_ = false;
   statistics_ = StepStatistics{};
   if (reference_) reference_->reset();
   if (effects_.steering_command()) effects_.steering_command()->value = initial_command(scene_, "steering_torque");

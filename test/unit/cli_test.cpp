@@ -2,6 +2,8 @@
 // devel/lib/birkhoff_cart/): CSV format, row times, numbers identical to an in-process Simulation
 // run, and its error paths (usage, unknown integrator, scene errors, a failing step).
 #include <gtest/gtest.h>
+
+#include <cmath>
 #include <limits.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -205,6 +207,25 @@ TEST(CartSimulate, FailingStepKeepsTheRowsWrittenAndNamesTheTime) {
   EXPECT_EQ(parse_row(lines[1])[0], 1.5707963267948966);
   std::remove(output.c_str());
   std::remove(broken_scene.c_str());
+}
+
+TEST(CartSimulate, PaperCaseEndsWithARowAtItsEndTimeOffTheOutputGrid) {
+  // paper_special runs from π/2 to 3.0: 3 − π/2 is not a whole number of 1/100 s intervals, so
+  // the rows are t0 + k/100 for k = 0..142 and one more at exactly t = 3.0 (a shorter last step).
+  const std::string output = temp_path("paper_end.csv");
+  const Outcome outcome = run_cli("--scene '" + scene_path("paper_special") + "' --output '" + output + "'");
+  ASSERT_EQ(outcome.exit_status, 0) << outcome.error_output;
+  const std::vector<std::string> lines = read_lines(output);
+  ASSERT_EQ(lines.size(), 1u + 143u + 1u);
+  const std::vector<double> before_last = parse_row(lines[lines.size() - 2]);
+  const std::vector<double> last = parse_row(lines.back());
+  EXPECT_EQ(before_last[0], 1.5707963267948966 + 142.0 / 100.0);
+  EXPECT_EQ(last[0], 3.0);
+  constexpr double kArcLengthColumn = 9;
+  constexpr double kRelativeTolerance = 1e-5;  // birkhoff2 at h = 1e-3 over 1.43 s [-]
+  const double exact_arc_length = 1.0 + std::log(std::tan(1.5));  // π1(3) = 1 + ln tan(3/2) [m]
+  EXPECT_NEAR(last[kArcLengthColumn], exact_arc_length, kRelativeTolerance * exact_arc_length);
+  std::remove(output.c_str());
 }
 
 }  // namespace

@@ -48,6 +48,22 @@ TEST(Simulation, AdvanceToStopsAtTheLastStepNotAfterTheTime) {
   EXPECT_EQ(simulation.state().time, 20 * 1e-3);
 }
 
+TEST(Simulation, StepToLandsOnAnEndTimeOffTheGridAndEndsTheRun) {
+  Simulation simulation(load("paper_special"));  // from π/2 to 3.0: the end is off the grid t₀ + n h
+  const double end = simulation.end_time();
+  while (simulation.state().time + simulation.step_size() <= end) simulation.step();
+  EXPECT_THROW(simulation.step_to(end + simulation.step_size()), std::invalid_argument);  // more than h
+  EXPECT_THROW(simulation.step_to(simulation.state().time), std::invalid_argument);       // zero length
+  simulation.step_to(end);
+  EXPECT_EQ(simulation.state().time, end);
+  const Diagnostics diagnostics = simulation.diagnostics();
+  EXPECT_LT(diagnostics.reference_arc_length_relative_error, kPaperReferenceTolerance * 10);
+  EXPECT_THROW(simulation.step(), std::logic_error);  // the run is over until reset
+  simulation.reset();
+  simulation.step();
+  EXPECT_EQ(simulation.state().time, simulation.scene().initial_state.time + simulation.step_size());
+}
+
 TEST(Simulation, ResetRestoresEverythingAndTheRunRepeatsBitForBit) {
   Scene scene = load("driven");
   scene.integrator.name = "dopri5";  // also carries an adaptive step-size guess between steps

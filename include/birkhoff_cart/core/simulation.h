@@ -39,6 +39,10 @@ class Simulation {
   void step();
   /// Steps while time + h/2 ≤ `time`.
   void advance_to(double time);
+  /// One final step of size time − t (0 < size ≤ h) that lands exactly on `time`: for an end time
+  /// off the step grid (the paper's case runs from π/2 to 3.0). Afterwards the run is over:
+  /// step() throws std::logic_error until reset(). Throws std::invalid_argument for a bad time.
+  void step_to(double time);
   /// Back to the scene's initial state, counters and reference included.
   void reset();
 
@@ -61,7 +65,10 @@ class Simulation {
   EffectSet effects_;
   std::unique_ptr<CartStepper> stepper_;
   CartState state_;
+  void take_step(double step_size, double next_time);
+
   std::uint64_t steps_taken_ = 0;
+  bool finished_off_grid_ = false;  ///< step_to() left the grid t₀ + n h
   StepStatistics statistics_;
   double initial_energy_ = 0.0;
   double initial_steering_momentum_ = 0.0;
