@@ -9,6 +9,7 @@
 
 #include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/effect_library.h"
+#include "birkhoff_cart/core/integrators/cart_stepper.h"
 #include "scene_reader.h"
 
 namespace birkhoff_cart {
@@ -17,9 +18,9 @@ namespace {
 using scene_detail::Range;
 using scene_detail::SceneReader;
 
-/// Mirrors the integrator registry (integrator_names() in cart_stepper.h).
+/// The integrator registry's names: one list for the loader and for make_cart_stepper.
 const std::vector<std::string>& known_integrators() {
-  static const std::vector<std::string> kNames = {"birkhoff2", "birkhoff4", "rk2", "rk4", "dopri5", "midpoint"};
+  static const std::vector<std::string> kNames = integrator_names();
   return kNames;
 }
 
