@@ -1,6 +1,6 @@
 // The ROS wrapper around a core Simulation (robot_localization style: the core knows nothing of
 // ROS; this class only translates). Every private parameter is read once in load_parameters() and
-// documented in docs/ros_interface.md (meaning, unit, default).
+// documented in README.md, "ROS interface" (meaning, unit, default).
 //
 // Time: the node steps the simulation in lockstep and publishes /clock itself (run with
 // /use_sim_time true); message stamps are the scene's time t (scene time t is ROS time t). The
@@ -29,7 +29,7 @@
 
 namespace birkhoff_cart {
 
-/// Every private parameter of cart_sim, with its default (docs/ros_interface.md).
+/// Every private parameter of cart_sim, with its default (README.md, "ROS interface").
 struct CartSimParameters {
   std::string scene_path;                    ///< ~scene: scene YAML (required)
   std::string integrator;                    ///< ~integrator: registry name; "" = the scene's

@@ -1,4 +1,4 @@
-// cart_sim: the simulator node (docs/ros_interface.md). All the work is in CartSimNode.
+// cart_sim: the simulator node (README.md, "ROS interface"). All the work is in CartSimNode.
 #include <ros/ros.h>
 
 #include "birkhoff_cart/ros/cart_sim_node.h"
