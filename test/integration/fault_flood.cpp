@@ -13,7 +13,6 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -36,39 +35,8 @@ constexpr double kFloodDuration = 10.0;          // [s of wall time]
 constexpr long kMemoryGrowthLimit = 16 * 1024;   // RSS growth over the flood [kB]
 constexpr double kMinimumPace = 0.8;             // scene seconds per wall second during the flood [-]
 
-std::string cart_sim_executable() {
-  std::array<char, 4096> path{};
-  const ssize_t length = ::readlink("/proc/self/exe", path.data(), path.size() - 1);
-  std::string self(path.data(), length > 0 ? static_cast<std::size_t>(length) : 0);
-  return self.substr(0, self.find_last_of('/') + 1) + "cart_sim";
-}
-
-pid_t start_cart_sim(const std::vector<std::string>& arguments) {
-  const std::string executable = cart_sim_executable();
-  std::vector<std::string> storage = {executable};
-  storage.insert(storage.end(), arguments.begin(), arguments.end());
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    std::vector<char*> argv;
-    for (auto& argument : storage) argv.push_back(argument.data());
-    argv.push_back(nullptr);
-    ::execv(executable.c_str(), argv.data());
-    ::_exit(127);
-  }
-  return pid;
-}
-
-int wait_exit(pid_t pid, double timeout) {
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
-  while (ros::WallTime::now() < deadline) {
-    int status = 0;
-    if (::waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    ros::WallDuration(0.02).sleep();
-  }
-  ::kill(pid, SIGKILL);
-  ::waitpid(pid, nullptr, 0);
-  return -1;
-}
+using birkhoff_cart_test::start_cart_sim;
+using birkhoff_cart_test::wait_exit;
 
 bool alive(pid_t pid) { return ::waitpid(pid, nullptr, WNOHANG) == 0; }
 

@@ -9,13 +9,11 @@
 //    joint_states messages and identical integration_error fields except wall_time_per_step.
 #include <gtest/gtest.h>
 
-#include <fcntl.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -39,10 +37,10 @@ constexpr double kWaitTimeout = 60.0;     // [s of wall time], only against hang
 constexpr double kPublishRate = 100.0;    // cart_sim's default ~publish_rate [Hz of scene time]
 constexpr double kStampTolerance = 1e-6;  // [s]; stamps are t0 + k/rate in ROS time (ns)
 
-bool file_exists(const std::string& path) {
-  struct stat info;
-  return ::stat(path.c_str(), &info) == 0;
-}
+using birkhoff_cart_test::file_exists;
+using birkhoff_cart_test::run_command;
+using birkhoff_cart_test::start_cart_sim;
+using birkhoff_cart_test::wait_exit;
 
 long file_size(const std::string& path) {
   struct stat info;
@@ -54,56 +52,6 @@ std::string read_file(const std::string& path) {
   std::stringstream text;
   text << file.rdbuf();
   return text.str();
-}
-
-int run_command(const std::string& command, std::string* output) {
-  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-  if (!pipe) return -1;
-  std::array<char, 512> buffer;
-  while (std::fgets(buffer.data(), buffer.size(), pipe)) *output += buffer.data();
-  const int status = ::pclose(pipe);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-std::string cart_sim_executable() {
-  std::array<char, 4096> path{};
-  const ssize_t length = ::readlink("/proc/self/exe", path.data(), path.size() - 1);
-  std::string self(path.data(), length > 0 ? static_cast<std::size_t>(length) : 0);
-  return self.substr(0, self.find_last_of('/') + 1) + "cart_sim";
-}
-
-/// Starts cart_sim as a child process with stdout and stderr going to `log`.
-pid_t start_cart_sim(const std::vector<std::string>& arguments, const std::string& log) {
-  const std::string executable = cart_sim_executable();
-  std::vector<std::string> storage = {executable};
-  storage.insert(storage.end(), arguments.begin(), arguments.end());
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (fd >= 0) {
-      ::dup2(fd, 1);
-      ::dup2(fd, 2);
-    }
-    std::vector<char*> argv;
-    for (auto& argument : storage) argv.push_back(argument.data());
-    argv.push_back(nullptr);
-    ::execv(executable.c_str(), argv.data());
-    ::_exit(127);
-  }
-  return pid;
-}
-
-/// Exit status of the child, −1 when it did not exit in time (then killed) or died of a signal.
-int wait_exit(pid_t pid, double timeout) {
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
-  while (ros::WallTime::now() < deadline) {
-    int status = 0;
-    if (::waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    ros::WallDuration(0.02).sleep();
-  }
-  ::kill(pid, SIGKILL);
-  ::waitpid(pid, nullptr, 0);
-  return -1;
 }
 
 std::string scene_parameter() {

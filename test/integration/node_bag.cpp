@@ -8,7 +8,6 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <array>
 #include <cstdio>
 #include <map>
 #include <string>
@@ -26,20 +25,11 @@ namespace {
 
 constexpr double kWaitTimeout = 60.0;  // [s of wall time], only against hangs
 
-bool file_exists(const std::string& path) {
-  struct stat info;
-  return ::stat(path.c_str(), &info) == 0;
-}
-
-std::string run_command(const std::string& command) {
-  std::string output;
-  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-  if (!pipe) return output;
-  std::array<char, 512> buffer;
-  while (std::fgets(buffer.data(), buffer.size(), pipe)) output += buffer.data();
-  ::pclose(pipe);
-  return output;
-}
+using birkhoff_cart_test::cart_sim_executable;
+using birkhoff_cart_test::file_exists;
+using birkhoff_cart_test::run_command;
+using birkhoff_cart_test::start_cart_sim;
+using birkhoff_cart_test::wait_exit;
 
 std::map<std::string, int> count_topics(const std::string& path) {
   rosbag::Bag bag(path, rosbag::bagmode::Read);
@@ -47,44 +37,6 @@ std::map<std::string, int> count_topics(const std::string& path) {
   std::map<std::string, int> counts;
   for (const rosbag::MessageInstance& message : view) ++counts[message.getTopic()];
   return counts;
-}
-
-/// cart_sim lives beside this test executable (devel/lib/birkhoff_cart/). Not through rosrun: it
-/// searches the whole package tree and may find several workspaces' builds.
-std::string cart_sim_executable() {
-  std::array<char, 4096> path{};
-  const ssize_t length = ::readlink("/proc/self/exe", path.data(), path.size() - 1);
-  std::string self(path.data(), length > 0 ? static_cast<std::size_t>(length) : 0);
-  return self.substr(0, self.find_last_of('/') + 1) + "cart_sim";
-}
-
-/// Starts cart_sim as a child process.
-pid_t start_cart_sim(const std::vector<std::string>& arguments) {
-  const std::string executable = cart_sim_executable();
-  std::vector<std::string> storage = {executable};
-  storage.insert(storage.end(), arguments.begin(), arguments.end());
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    std::vector<char*> argv;
-    for (auto& argument : storage) argv.push_back(argument.data());
-    argv.push_back(nullptr);
-    ::execv(executable.c_str(), argv.data());
-    ::_exit(127);
-  }
-  return pid;
-}
-
-/// Waits for the child; returns its exit status (or −1 when it did not exit in time or was killed).
-int wait_exit(pid_t pid, double timeout) {
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
-  while (ros::WallTime::now() < deadline) {
-    int status = 0;
-    if (::waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    ros::WallDuration(0.02).sleep();
-  }
-  ::kill(pid, SIGKILL);
-  ::waitpid(pid, nullptr, 0);
-  return -1;
 }
 
 TEST(NodeBag, RecordHasTopicsCountsAndCompression) {
@@ -138,7 +90,8 @@ TEST(NodeBag, RecordHasTopicsCountsAndCompression) {
   bag.close();
 
   // `rosbag info` (python rosbag) reads it, and it is LZ4-compressed.
-  const std::string info = run_command("rosbag info --yaml " + bag_path);
+  std::string info;
+  run_command("rosbag info --yaml " + bag_path, &info);
   EXPECT_NE(info.find("compression: lz4"), std::string::npos) << info;
   EXPECT_NE(info.find("/odom"), std::string::npos) << info;
   std::remove(bag_path.c_str());

@@ -1,8 +1,19 @@
 // Small helpers shared by the rostest nodes: waiting on a condition while spinning (wall-clock
-// timeouts only guard against hangs; the conditions are messages and sim time).
+// timeouts only guard against hangs; the conditions are messages and sim time), and running a
+// second cart_sim as a child process (start, wait for its exit) with the files it leaves behind.
 #pragma once
 
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
 #include <functional>
+#include <string>
+#include <vector>
 
 #include <ros/ros.h>
 #include <std_srvs/SetBool.h>
@@ -27,6 +38,73 @@ inline bool set_paused(const std::string& service, bool paused) {
   std_srvs::SetBool call;
   call.request.data = paused;
   return ros::service::call(service, call) && call.response.success;
+}
+
+/// cart_sim lives beside the test executable (devel/lib/birkhoff_cart/), found through
+/// /proc/self/exe. Not through rosrun: it searches the whole package tree and may find several
+/// workspaces' builds.
+inline std::string cart_sim_executable() {
+  std::array<char, 4096> path{};
+  const ssize_t length = ::readlink("/proc/self/exe", path.data(), path.size() - 1);
+  std::string self(path.data(), length > 0 ? static_cast<std::size_t>(length) : 0);
+  return self.substr(0, self.find_last_of('/') + 1) + "cart_sim";
+}
+
+/// Starts cart_sim as a child process (fork + execv) with `arguments` (ROS remappings and
+/// _private:=value parameters). With a non-empty `log` its stdout and stderr go to that file;
+/// otherwise they stay the test's. Returns the child's pid (≤ 0 when fork failed); a child that
+/// cannot exec cart_sim exits 127.
+inline pid_t start_cart_sim(const std::vector<std::string>& arguments, const std::string& log = "") {
+  const std::string executable = cart_sim_executable();
+  std::vector<std::string> storage = {executable};
+  storage.insert(storage.end(), arguments.begin(), arguments.end());
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    if (!log.empty()) {
+      const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      if (fd >= 0) {
+        ::dup2(fd, 1);
+        ::dup2(fd, 2);
+      }
+    }
+    std::vector<char*> argv;
+    for (auto& argument : storage) argv.push_back(argument.data());
+    argv.push_back(nullptr);
+    ::execv(executable.c_str(), argv.data());
+    ::_exit(127);
+  }
+  return pid;
+}
+
+/// Waits up to `timeout` [s of wall time] for the child `pid` and returns its exit status; −1 when
+/// it died of a signal or did not exit in time (then it is killed with SIGKILL and reaped).
+inline int wait_exit(pid_t pid, double timeout) {
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
+  while (ros::WallTime::now() < deadline) {
+    int status = 0;
+    if (::waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    ros::WallDuration(0.02).sleep();
+  }
+  ::kill(pid, SIGKILL);
+  ::waitpid(pid, nullptr, 0);
+  return -1;
+}
+
+/// True when `path` exists (a bag under its final name, or its ".active" file while recording).
+inline bool file_exists(const std::string& path) {
+  struct stat info;
+  return ::stat(path.c_str(), &info) == 0;
+}
+
+/// Runs the shell `command` with stderr merged into stdout, appends what it printed to `output`,
+/// and returns its exit status (−1 when it could not run or died of a signal).
+inline int run_command(const std::string& command, std::string* output) {
+  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return -1;
+  std::array<char, 512> buffer;
+  while (std::fgets(buffer.data(), buffer.size(), pipe)) *output += buffer.data();
+  const int status = ::pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 }  // namespace birkhoff_cart_test
