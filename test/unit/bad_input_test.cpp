@@ -25,6 +25,7 @@
 #include "birkhoff_cart/core/integrators/cart_stepper.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
+#include "test_scenes.h"
 
 namespace birkhoff_cart {
 namespace {
@@ -34,9 +35,9 @@ constexpr int kFloodSteps = 10000;                      // 10 s at h = 1 ms
 constexpr int kCommandsPerStep = 10;                    // 10 kHz of commands against 1 kHz of steps
 constexpr long kFloodMemoryGrowthLimit = 1024;          // resident set growth [kB] over the flood
 
-std::string scene_path(const std::string& name) {
-  return std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/" + name + ".yaml";
-}
+using birkhoff_cart_test::CliOutcome;
+using birkhoff_cart_test::directory_of_this_binary;
+using birkhoff_cart_test::scene_path;
 
 bool same_state(const CartState& a, const CartState& b) { return std::memcmp(&a, &b, sizeof(CartState)) == 0; }
 
@@ -142,61 +143,12 @@ TEST(BadCommands, AFloodOfCommandsKeepsMemoryFlatAndTheLatestValidOneWins) {
 // ---------------------------------------------------------------------------------------------
 // §9 The CLI on malformed scenes and bad options.
 
-std::string directory_of_this_binary() {
-  std::array<char, 4096> path{};
-  const ssize_t length = readlink("/proc/self/exe", path.data(), path.size() - 1);
-  if (length <= 0) return ".";
-  const std::string full(path.data(), static_cast<std::size_t>(length));
-  return full.substr(0, full.rfind('/'));
-}
-
-struct CliResult {
-  int exit_status = -1;
-  std::string standard_error;
-};
-
 /// Runs cart_simulate with `arguments` (shell-quoted by the caller), capturing stderr.
-CliResult run_cli(const std::string& arguments, const std::string& scratch) {
-  const std::string error_file = scratch + "/stderr.txt";
-  const std::string command =
-      "'" + directory_of_this_binary() + "/cart_simulate' " + arguments + " 2> '" + error_file + "' > /dev/null";
-  CliResult result;
-  const int status = std::system(command.c_str());
-  result.exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream error(error_file);
-  std::stringstream text;
-  text << error.rdbuf();
-  result.standard_error = text.str();
-  return result;
+CliOutcome run_cli(const std::string& arguments, const std::string& scratch) {
+  return birkhoff_cart_test::run_cart_simulate(arguments, scratch + "/stderr.txt");
 }
 
-const char* const kMinimalScene = R"(description: minimal CLI scene
-cart:
-  wheelbase: 1.05
-  rear_half_track: 0.55
-  front_half_track: 0.5
-  rear_wheel_radius: 0.14
-  front_wheel_radius: 0.13
-  rear_body_mass: 140.0
-  rear_body_yaw_inertia: 30.0
-  front_axle_mass: 12.0
-  front_axle_yaw_inertia: 1.0
-  rear_wheel_mass: 3.0
-  rear_wheel_spin_inertia: 0.03
-  rear_wheel_yaw_inertia: 0.025
-  front_wheel_mass: 2.2
-  front_wheel_spin_inertia: 0.019
-  front_wheel_yaw_inertia: 0.013
-  gravity: 9.81
-initial_state:
-  steering_angle: 0.1
-  forward_speed: 2.0
-  steering_rate: 0.3
-duration: 0.5
-integrator:
-  name: rk4
-  step_size: 0.01
-)";
+const std::string kMinimalScene = birkhoff_cart_test::minimal_scene("minimal CLI scene", "0.5");
 
 class Cli : public ::testing::Test {
  protected:
@@ -214,11 +166,7 @@ class Cli : public ::testing::Test {
     return path;
   }
   static std::string edited(const std::string& from, const std::string& to) {
-    std::string text = kMinimalScene;
-    const std::size_t at = text.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    if (at != std::string::npos) text.replace(at, from.size(), to);
-    return text;
+    return birkhoff_cart_test::replaced_once(kMinimalScene, from, to);
   }
   std::string output() const { return directory_ + "/out.csv"; }
   std::string directory_;
@@ -259,7 +207,7 @@ TEST_F(Cli, EveryMalformedSceneExitsThreeWithOneLineNamingFileAndKey) {
   ASSERT_GE(cases.size(), 15u);
   for (const MalformedScene& malformed : cases) {
     const std::string path = write(malformed.label, malformed.text);
-    const CliResult result = run_cli("--scene '" + path + "' --output '" + output() + "'", directory_);
+    const CliOutcome result = run_cli("--scene '" + path + "' --output '" + output() + "'", directory_);
     EXPECT_EQ(result.exit_status, 3) << malformed.label << ": " << result.standard_error;
     const std::string expected_start = "cart_simulate: scene " + path + ": key '" + malformed.key + "': ";
     EXPECT_EQ(result.standard_error.rfind(expected_start, 0), 0u) << malformed.label << ": " << result.standard_error;
@@ -267,7 +215,8 @@ TEST_F(Cli, EveryMalformedSceneExitsThreeWithOneLineNamingFileAndKey) {
     EXPECT_EQ(result.standard_error.find('\n'), result.standard_error.size() - 1) << malformed.label;
   }
   // A file that does not exist is named too.
-  const CliResult missing = run_cli("--scene '" + directory_ + "/nowhere.yaml' --output '" + output() + "'", directory_);
+  const CliOutcome missing =
+      run_cli("--scene '" + directory_ + "/nowhere.yaml' --output '" + output() + "'", directory_);
   EXPECT_EQ(missing.exit_status, 3);
   EXPECT_NE(missing.standard_error.find(directory_ + "/nowhere.yaml"), std::string::npos) << missing.standard_error;
 }
@@ -275,23 +224,23 @@ TEST_F(Cli, EveryMalformedSceneExitsThreeWithOneLineNamingFileAndKey) {
 TEST_F(Cli, BadOptionsExitTwoAndAnUnwritableOutputExitsThree) {
   const std::string scene = write("good", kMinimalScene);
   for (const char* step : {"nan", "-0.01", "0", "1e400", "fast"}) {
-    const CliResult result =
+    const CliOutcome result =
         run_cli("--scene '" + scene + "' --step " + step + " --output '" + output() + "'", directory_);
     EXPECT_EQ(result.exit_status, 2) << step << ": " << result.standard_error;
     EXPECT_NE(result.standard_error.find("--step"), std::string::npos) << result.standard_error;
   }
-  const CliResult unknown = run_cli("--scene '" + scene + "' --colour red --output '" + output() + "'", directory_);
+  const CliOutcome unknown = run_cli("--scene '" + scene + "' --colour red --output '" + output() + "'", directory_);
   EXPECT_EQ(unknown.exit_status, 2);
-  const CliResult unwritable = run_cli("--scene '" + scene + "' --output /proc/no_such_dir/out.csv", directory_);
+  const CliOutcome unwritable = run_cli("--scene '" + scene + "' --output /proc/no_such_dir/out.csv", directory_);
   EXPECT_EQ(unwritable.exit_status, 3) << unwritable.standard_error;
   EXPECT_NE(unwritable.standard_error.find("/proc/no_such_dir/out.csv"), std::string::npos) << unwritable.standard_error;
-  const CliResult good = run_cli("--scene '" + scene + "' --output '" + output() + "'", directory_);
+  const CliOutcome good = run_cli("--scene '" + scene + "' --output '" + output() + "'", directory_);
   EXPECT_EQ(good.exit_status, 0) << good.standard_error;
 }
 
 TEST_F(Cli, AFailedStepExitsFourKeepingTheRowsAndNamingTheSingularTime) {
   // The paper's case run past its pole at t = π (docs/hard_cases.md §1).
-  const CliResult result = run_cli("--scene '" + scene_path("paper_special") +
+  const CliOutcome result = run_cli("--scene '" + scene_path("paper_special") +
                                        "' --duration 2.0 --output '" + output() + "'",
                                    directory_);
   EXPECT_EQ(result.exit_status, 4) << result.standard_error;

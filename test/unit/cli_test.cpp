@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <limits.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -16,50 +15,24 @@
 
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
+#include "test_scenes.h"
 
 namespace birkhoff_cart {
 namespace {
 
 const char* const kHeader = "t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2";
 
-std::string scene_path(const std::string& name) {
-  return std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/" + name + ".yaml";
-}
-
-/// devel/lib/birkhoff_cart/cart_simulate, found from this test's own executable.
-std::string cli_path() {
-  char buffer[PATH_MAX];
-  const ssize_t length = readlink("/proc/self/exe", buffer, sizeof(buffer) - 1);
-  if (length <= 0) return "cart_simulate";
-  std::string self(buffer, static_cast<std::size_t>(length));
-  return self.substr(0, self.find_last_of('/')) + "/cart_simulate";
-}
-
-struct Outcome {
-  int exit_status = -1;
-  std::string error_output;
-};
+using birkhoff_cart_test::CliOutcome;
+using birkhoff_cart_test::read_file;
+using birkhoff_cart_test::scene_path;
 
 std::string temp_path(const std::string& name) {
   return ::testing::TempDir() + "cli_test_" + std::to_string(getpid()) + "_" + name;
 }
 
-std::string read_file(const std::string& path) {
-  std::ifstream file(path);
-  std::stringstream text;
-  text << file.rdbuf();
-  return text.str();
-}
-
-Outcome run_cli(const std::string& arguments) {
-  const std::string stderr_path = temp_path("stderr.txt");
-  const std::string command = "'" + cli_path() + "' " + arguments + " 2> '" + stderr_path + "'";
-  const int status = std::system(command.c_str());
-  Outcome outcome;
-  outcome.exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  outcome.error_output = read_file(stderr_path);
-  std::remove(stderr_path.c_str());
-  return outcome;
+/// Runs cart_simulate (next to this test binary) with `arguments`, capturing stderr.
+CliOutcome run_cli(const std::string& arguments) {
+  return birkhoff_cart_test::run_cart_simulate(arguments, temp_path("stderr.txt"));
 }
 
 std::vector<std::string> read_lines(const std::string& path) {
@@ -117,8 +90,8 @@ void expect_matches_simulation(const Scene& scene, const std::vector<std::string
 
 TEST(CartSimulate, FreeCoastCsvMatchesASimulationRunBitForBit) {
   const std::string output = temp_path("free_coast.csv");
-  const Outcome outcome = run_cli("--scene '" + scene_path("free_coast") + "' --output '" + output + "'");
-  ASSERT_EQ(outcome.exit_status, 0) << outcome.error_output;
+  const CliOutcome outcome = run_cli("--scene '" + scene_path("free_coast") + "' --output '" + output + "'");
+  ASSERT_EQ(outcome.exit_status, 0) << outcome.standard_error;
   const std::vector<std::string> lines = read_lines(output);
   const Scene scene = load_scene(scene_path("free_coast"));  // 6 s at 100 Hz: 601 rows
   ASSERT_EQ(lines.size(), 602u);
@@ -130,11 +103,11 @@ TEST(CartSimulate, FreeCoastCsvMatchesASimulationRunBitForBit) {
 
 TEST(CartSimulate, CommandLineOverridesTheScene) {
   const std::string output = temp_path("overrides.csv");
-  const Outcome outcome =
+  const CliOutcome outcome =
       run_cli("--scene '" + scene_path("free_coast") +
               "' --integrator rk4 --step 2e-3 --output-rate 50 --duration 1 --birkhoffian-form paper --output '" +
               output + "'");
-  ASSERT_EQ(outcome.exit_status, 0) << outcome.error_output;
+  ASSERT_EQ(outcome.exit_status, 0) << outcome.standard_error;
   Scene scene = load_scene(scene_path("free_coast"));
   scene.integrator.name = "rk4";
   scene.integrator.step_size = 2e-3;
@@ -155,34 +128,34 @@ TEST(CartSimulate, BadArgumentsExitNonZeroWithUsage) {
       "", scene, output, both + " --frobnicate 1", both + " --step abc", both + " --step 0",
       both + " --duration -2", both + " --step", both + " --birkhoffian-form lagrangian"};
   for (const std::string& arguments : bad_arguments) {
-    const Outcome outcome = run_cli(arguments);
+    const CliOutcome outcome = run_cli(arguments);
     EXPECT_NE(outcome.exit_status, 0) << arguments;
-    EXPECT_NE(outcome.error_output.find("usage: cart_simulate"), std::string::npos) << arguments;
+    EXPECT_NE(outcome.standard_error.find("usage: cart_simulate"), std::string::npos) << arguments;
   }
 }
 
 TEST(CartSimulate, UnknownIntegratorNamesTheKnownOnes) {
-  const Outcome outcome = run_cli("--scene '" + scene_path("free_coast") + "' --integrator euler --output '" +
+  const CliOutcome outcome = run_cli("--scene '" + scene_path("free_coast") + "' --integrator euler --output '" +
                                   temp_path("never.csv") + "'");
   EXPECT_NE(outcome.exit_status, 0);
   for (const char* name : {"euler", "birkhoff2", "birkhoff4", "rk2", "rk4", "dopri5", "midpoint"}) {
-    EXPECT_NE(outcome.error_output.find(name), std::string::npos) << outcome.error_output;
+    EXPECT_NE(outcome.standard_error.find(name), std::string::npos) << outcome.standard_error;
   }
 }
 
 TEST(CartSimulate, SceneErrorIsOneLineNamingTheFile) {
   const std::string missing = temp_path("no_such_scene.yaml");
-  const Outcome outcome = run_cli("--scene '" + missing + "' --output '" + temp_path("never.csv") + "'");
+  const CliOutcome outcome = run_cli("--scene '" + missing + "' --output '" + temp_path("never.csv") + "'");
   EXPECT_NE(outcome.exit_status, 0);
-  EXPECT_NE(outcome.error_output.find(missing), std::string::npos) << outcome.error_output;
-  EXPECT_EQ(outcome.error_output.find('\n'), outcome.error_output.size() - 1) << outcome.error_output;
+  EXPECT_NE(outcome.standard_error.find(missing), std::string::npos) << outcome.standard_error;
+  EXPECT_EQ(outcome.standard_error.find('\n'), outcome.standard_error.size() - 1) << outcome.standard_error;
 }
 
 TEST(CartSimulate, OutputIntervalMustBeWholeSteps) {
-  const Outcome outcome = run_cli("--scene '" + scene_path("free_coast") + "' --step 3e-3 --output '" +
+  const CliOutcome outcome = run_cli("--scene '" + scene_path("free_coast") + "' --step 3e-3 --output '" +
                                   temp_path("never.csv") + "'");
   EXPECT_NE(outcome.exit_status, 0);
-  EXPECT_NE(outcome.error_output.find("not a whole number of steps"), std::string::npos) << outcome.error_output;
+  EXPECT_NE(outcome.standard_error.find("not a whole number of steps"), std::string::npos) << outcome.standard_error;
 }
 
 TEST(CartSimulate, FailingStepKeepsTheRowsWrittenAndNamesTheTime) {
@@ -198,9 +171,9 @@ TEST(CartSimulate, FailingStepKeepsTheRowsWrittenAndNamesTheTime) {
   const std::string broken_scene = temp_path("singular.yaml");
   std::ofstream(broken_scene) << text;
   const std::string output = temp_path("singular.csv");
-  const Outcome outcome = run_cli("--scene '" + broken_scene + "' --output '" + output + "'");
+  const CliOutcome outcome = run_cli("--scene '" + broken_scene + "' --output '" + output + "'");
   EXPECT_NE(outcome.exit_status, 0);
-  EXPECT_NE(outcome.error_output.find("t = 1.5707963267948966"), std::string::npos) << outcome.error_output;
+  EXPECT_NE(outcome.standard_error.find("t = 1.5707963267948966"), std::string::npos) << outcome.standard_error;
   const std::vector<std::string> lines = read_lines(output);
   ASSERT_EQ(lines.size(), 2u);
   EXPECT_EQ(lines[0], kHeader);
@@ -213,8 +186,8 @@ TEST(CartSimulate, PaperCaseEndsWithARowAtItsEndTimeOffTheOutputGrid) {
   // paper_special runs from π/2 to 3.0: 3 − π/2 is not a whole number of 1/100 s intervals, so
   // the rows are t0 + k/100 for k = 0..142 and one more at exactly t = 3.0 (a shorter last step).
   const std::string output = temp_path("paper_end.csv");
-  const Outcome outcome = run_cli("--scene '" + scene_path("paper_special") + "' --output '" + output + "'");
-  ASSERT_EQ(outcome.exit_status, 0) << outcome.error_output;
+  const CliOutcome outcome = run_cli("--scene '" + scene_path("paper_special") + "' --output '" + output + "'");
+  ASSERT_EQ(outcome.exit_status, 0) << outcome.standard_error;
   const std::vector<std::string> lines = read_lines(output);
   ASSERT_EQ(lines.size(), 1u + 143u + 1u);
   const std::vector<double> before_last = parse_row(lines[lines.size() - 2]);

@@ -23,6 +23,7 @@
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
 #include "birkhoff_cart/core/singular_steering.h"
+#include "test_scenes.h"
 
 namespace birkhoff_cart {
 namespace {
@@ -68,9 +69,7 @@ constexpr double kLargeStepDuration = 6.0;
 // midpoint on the 1 cm cart at h = 1e-5; ≤ 6e-6 for the light and heavy carts at h = 1e-3).
 constexpr double kExtremeEnergyRelativeTolerance = 1e-2;
 
-std::string scene_path(const std::string& name) {
-  return std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/" + name + ".yaml";
-}
+using birkhoff_cart_test::scene_path;
 
 Scene shipped(const std::string& name) { return load_scene(scene_path(name)); }
 

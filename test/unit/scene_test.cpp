@@ -14,15 +14,14 @@
 
 #include "birkhoff_cart/core/effect_library.h"
 #include "birkhoff_cart/core/scene.h"
+#include "test_scenes.h"
 
 namespace birkhoff_cart {
 namespace {
 
 constexpr double kExact = 0.0;  // values read from a file must round-trip exactly [-]
 
-std::string scene_path(const std::string& name) {
-  return std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/" + name + ".yaml";
-}
+using birkhoff_cart_test::scene_path;
 
 const EffectSpec* find_effect(const Scene& scene, const std::string& name) {
   for (const EffectSpec& spec : scene.effects) {
@@ -175,33 +174,7 @@ TEST(ShippedScenes, PaperSpecialCase) {
 // Scenes written by the tests into a private temporary directory.
 
 /// A minimal valid scene: every required key, no optional one.
-const char* const kMinimalScene = R"(description: minimal test scene
-cart:
-  wheelbase: 1.05
-  rear_half_track: 0.55
-  front_half_track: 0.5
-  rear_wheel_radius: 0.14
-  front_wheel_radius: 0.13
-  rear_body_mass: 140.0
-  rear_body_yaw_inertia: 30.0
-  front_axle_mass: 12.0
-  front_axle_yaw_inertia: 1.0
-  rear_wheel_mass: 3.0
-  rear_wheel_spin_inertia: 0.03
-  rear_wheel_yaw_inertia: 0.025
-  front_wheel_mass: 2.2
-  front_wheel_spin_inertia: 0.019
-  front_wheel_yaw_inertia: 0.013
-  gravity: 9.81
-initial_state:
-  steering_angle: 0.1
-  forward_speed: 2.0
-  steering_rate: 0.3
-duration: 5.0
-integrator:
-  name: rk4
-  step_size: 0.01
-)";
+const std::string kMinimalScene = birkhoff_cart_test::minimal_scene("minimal test scene", "5.0");
 
 class SceneFiles : public ::testing::Test {
  protected:
@@ -222,11 +195,7 @@ class SceneFiles : public ::testing::Test {
   }
   /// kMinimalScene with `from` replaced by `to` (which must occur).
   static std::string edited(const std::string& from, const std::string& to) {
-    std::string text = kMinimalScene;
-    const std::size_t at = text.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    if (at != std::string::npos) text.replace(at, from.size(), to);
-    return text;
+    return birkhoff_cart_test::replaced_once(kMinimalScene, from, to);
   }
 
   std::string directory_;
