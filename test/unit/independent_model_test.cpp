@@ -262,22 +262,41 @@ TEST(IndependentModel, InstantaneousAccelerationsAgreeAtRandomStates) {
   std::cout << "[ measured ] max relative |ω̇_full − ω̇_reduced| over 200 random states: " << worst << "\n";
 }
 
+/// CartModel's reduced accelerations ω̇ (docs eq. (3.4)) in the form compare_trajectories takes.
+auto cart_model_acceleration(const CartModel& model) {
+  return [&model](double chi, const Vector2<double>& w, const Vector2<double>& force) {
+    return model.quasi_acceleration(chi, w, force);
+  };
+}
+
+/// Steering and drive torques of the steering-and-drive run, shared by the agreement test and the
+/// refutation of the paper's printed μ1 so that both integrate the same motion.
+LoadHistory steering_and_drive_history() {
+  LoadHistory history;
+  history.steering_offset = 0.5;     // [N·m]
+  history.steering_amplitude = 6.0;  // [N·m]
+  history.steering_frequency = 1.7;  // [rad/s]
+  history.drive_mean = 25.0;         // [N·m]
+  history.drive_amplitude = 15.0;    // [N·m]
+  history.drive_frequency = 0.9;     // [rad/s]
+  return history;
+}
+
+/// Start configuration q0 = (x, y, θ, χ, φ1..φ4) [m, m, rad, rad, rad ×4] of the steering-and-drive
+/// run.
+Vector8 steering_and_drive_start() {
+  Vector8 q0;
+  q0 << 0.3, -0.2, 0.4, 0.25, 0.1, -0.2, 0.3, 0.05;
+  return q0;
+}
+
 TEST(IndependentModel, TrajectoriesAgreeUnderSteeringAndDriveTorque) {
   const CartParameters parameters;
   const CartModel model(parameters);
-  LoadHistory history;
-  history.steering_offset = 0.5;
-  history.steering_amplitude = 6.0;
-  history.steering_frequency = 1.7;
-  history.drive_mean = 25.0;
-  history.drive_amplitude = 15.0;
-  history.drive_frequency = 0.9;
-  Vector8 q0;
-  q0 << 0.3, -0.2, 0.4, 0.25, 0.1, -0.2, 0.3, 0.05;
-  const auto cart_model_acceleration = [&](double chi, const Vector2<double>& w, const Vector2<double>& force) {
-    return model.quasi_acceleration(chi, w, force);
-  };
-  const Comparison result = compare_trajectories(parameters, cart_model_acceleration, history, q0, 1.2, 0.4, 5.0);
+  const LoadHistory history = steering_and_drive_history();
+  const Vector8 q0 = steering_and_drive_start();
+  const Comparison result =
+      compare_trajectories(parameters, cart_model_acceleration(model), history, q0, 1.2, 0.4, 5.0);
   std::cout << "[ measured ] 5 s, steering + drive torque: max disagreement " << result.max_difference
             << ", full-model constraint drift " << result.max_constraint_residual << " m/s, χ in ["
             << result.min_steering_angle << ", " << result.max_steering_angle << "] rad, final ω1 "
@@ -298,10 +317,8 @@ TEST(IndependentModel, TrajectoriesAgreeWhileSteeringSwingsThroughRightAngles) {
   history.drive_frequency = 2.1;
   Vector8 q0;
   q0 << -1.0, 2.0, -0.7, 0.0, 0.0, 0.0, 0.0, 0.0;
-  const auto cart_model_acceleration = [&](double chi, const Vector2<double>& w, const Vector2<double>& force) {
-    return model.quasi_acceleration(chi, w, force);
-  };
-  const Comparison result = compare_trajectories(parameters, cart_model_acceleration, history, q0, 0.8, -4.6, 5.0);
+  const Comparison result =
+      compare_trajectories(parameters, cart_model_acceleration(model), history, q0, 0.8, -4.6, 5.0);
   std::cout << "[ measured ] 5 s, χ through ±π/2: max disagreement " << result.max_difference
             << ", full-model constraint drift " << result.max_constraint_residual << " m/s, χ in ["
             << result.min_steering_angle << ", " << result.max_steering_angle << "] rad\n";
@@ -363,10 +380,7 @@ TEST(IndependentModel, TrajectoriesAgreeWithRollingResistanceAirDragAndHingeSpri
   history.drive_frequency = 0.8;
   Vector8 q0;
   q0 << 0.0, 0.0, 0.2, -0.3, 0.0, 0.0, 0.0, 0.0;
-  const auto cart_model_acceleration = [&](double chi, const Vector2<double>& w, const Vector2<double>& force) {
-    return model.quasi_acceleration(chi, w, force);
-  };
-  const Comparison result = compare_trajectories(p, cart_model_acceleration, history, q0, 2.0, 0.5, 5.0,
+  const Comparison result = compare_trajectories(p, cart_model_acceleration(model), history, q0, 2.0, 0.5, 5.0,
                                                  reduced_effects, full_effects);
   std::cout << "[ measured ] 5 s, all dissipative effects: max disagreement " << result.max_difference
             << ", χ in [" << result.min_steering_angle << ", " << result.max_steering_angle << "] rad, final ω1 "
@@ -383,15 +397,8 @@ TEST(IndependentModel, PaperPrintedMu1IsRefutedByTheFullModel) {
   printed.mu1 = paper_printed_mu1(parameters);
   std::cout << "[ measured ] μ1 correct " << model.inertia().mu1 << " kg, printed " << printed.mu1 << " kg\n";
   ASSERT_GT(std::abs(printed.mu1 - model.inertia().mu1), 0.5);
-  LoadHistory history;
-  history.steering_offset = 0.5;
-  history.steering_amplitude = 6.0;
-  history.steering_frequency = 1.7;
-  history.drive_mean = 25.0;
-  history.drive_amplitude = 15.0;
-  history.drive_frequency = 0.9;
-  Vector8 q0;
-  q0 << 0.3, -0.2, 0.4, 0.25, 0.1, -0.2, 0.3, 0.05;
+  const LoadHistory history = steering_and_drive_history();
+  const Vector8 q0 = steering_and_drive_start();
   const auto printed_acceleration = [&](double chi, const Vector2<double>& w, const Vector2<double>& force) {
     return boltzmann_hamel_acceleration(printed, chi, w, force);
   };
