@@ -59,6 +59,10 @@ void check_structure_against_ad(const System& system, const Eigen::Matrix<double
   const Eigen::Matrix<double, N, N> k_ad = dr_dz - dr_dz.transpose();
   const Eigen::Matrix<double, N, N> k = system.structure_matrix(z, t);
   EXPECT_LE(relative_difference(k, k_ad), kStructureTolerance) << "K\n" << k << "\nAD\n" << k_ad;
+  if constexpr (birkhoffian_system_detail::HasStructureMatrixInverse<System, double>::value) {
+    const Eigen::Matrix<double, N, N> k_inverse = system.structure_matrix_inverse(z, t);  // analytic K⁻¹
+    EXPECT_LE(relative_difference(k_inverse * k, Eigen::Matrix<double, N, N>::Identity()), kStructureTolerance);
+  }
   const Eigen::Matrix<double, N, 1> gradient = system.birkhoffian_gradient(z, t);
   EXPECT_LE(relative_difference(gradient, b.derivatives().template head<N>()), kStructureTolerance)
       << gradient.transpose() << " vs AD " << b.derivatives().transpose();

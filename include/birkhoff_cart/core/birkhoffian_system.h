@@ -14,6 +14,7 @@
 //   template <class S> Vector<S>  birkhoff_functions(const Vector<S>& z, const S& t) const;   // R
 //   template <class S> S          birkhoffian(const Vector<S>& z, const S& t) const;          // B
 //   template <class S> Matrix<S>  structure_matrix(const Vector<S>& z, const S& t) const;     // K, analytic
+//   (optional) template <class S> Matrix<S> structure_matrix_inverse(z, t) const;            // K⁻¹, analytic
 //   template <class S> Vector<S>  birkhoffian_gradient(const Vector<S>& z, const S& t) const; // ∇B, analytic
 //   template <class S> Vector<S>  birkhoff_functions_time_derivative(const Vector<S>& z, const S& t) const; // ∂R/∂t
 //   template <class S> Vector<S>  non_birkhoffian_force(const Vector<S>& z, const S& t) const; // Λ (zero
@@ -61,14 +62,30 @@ Eigen::Matrix<double, Dimension, Dimension> canonical_structure() {
   return k;
 }
 
+namespace birkhoffian_system_detail {
+template <class System, class S, class = void>
+struct HasStructureMatrixInverse : std::false_type {};
+template <class System, class S>
+struct HasStructureMatrixInverse<System, S,
+                                 std::void_t<decltype(std::declval<const System&>().structure_matrix_inverse(
+                                     std::declval<const StateVector<System, S>&>(), std::declval<const S&>()))>>
+    : std::true_type {};
+}  // namespace birkhoffian_system_detail
+
 /// ż = K(z,t)⁻¹ (∇B + ∂R/∂t + Λ): Birkhoff's equations solved for the rates (docs eq. (B.1)).
+/// A system may provide an analytic `structure_matrix_inverse(z, t)` (e.g. K₀⁻¹ = −K₀ for the
+/// cart); otherwise K is LU-factored at every call.
 template <class System, class S>
 StateVector<System, S> birkhoffian_rates(const System& system, const StateVector<System, S>& z, const S& t) {
-  const StructureMatrix<System, S> k = system.structure_matrix(z, t);
   const StateVector<System, S> right_hand_side = system.birkhoffian_gradient(z, t) +
                                                  system.birkhoff_functions_time_derivative(z, t) +
                                                  system.non_birkhoffian_force(z, t);
-  return k.partialPivLu().solve(right_hand_side);
+  if constexpr (birkhoffian_system_detail::HasStructureMatrixInverse<System, S>::value) {
+    return system.structure_matrix_inverse(z, t) * right_hand_side;
+  } else {
+    const StructureMatrix<System, S> k = system.structure_matrix(z, t);
+    return k.partialPivLu().solve(right_hand_side);
+  }
 }
 
 namespace birkhoffian_system_detail {

@@ -157,6 +157,11 @@ class CartAutonomousBirkhoffian : public CartBirkhoffianBase {
   Matrix<S> structure_matrix(const Vector<S>& /*z*/, const S& /*t*/) const {
     return canonical_structure<kDimension>().template cast<S>();
   }
+  /// K⁻¹ = K₀⁻¹ = −K₀ (K₀² = −I).
+  template <class S>
+  Matrix<S> structure_matrix_inverse(const Vector<S>& /*z*/, const S& /*t*/) const {
+    return (-canonical_structure<kDimension>()).template cast<S>();
+  }
   template <class S>
   Vector<S> birkhoffian_gradient(const Vector<S>& z, const S& /*t*/) const {
     return hamiltonian_gradient(z);
@@ -238,6 +243,11 @@ class CartPaperBirkhoffian : public CartBirkhoffianBase {
   template <class S>
   Matrix<S> structure_matrix(const Vector<S>& /*z*/, const S& t) const {
     return canonical_structure<kDimension>().template cast<S>() * conformal_factor(t);
+  }
+  /// K⁻¹ = −e^{−(t−tₑ)} K₀.
+  template <class S>
+  Matrix<S> structure_matrix_inverse(const Vector<S>& /*z*/, const S& t) const {
+    return canonical_structure<kDimension>().template cast<S>() * (-1.0 / conformal_factor(t));
   }
   template <class S>
   Vector<S> birkhoffian_gradient(const Vector<S>& z, const S& t) const {

@@ -100,9 +100,12 @@ std::string describe_failure(const char* what, double time, int iterations, doub
 /// iterate or residual is not finite, the Jacobian is singular, or there is no convergence within
 /// settings.max_iterations.
 ///
-/// Convergence: stop after the first update with ‖Δx‖∞ ≤ tol·‖x‖∞, plus one extra update (quadratic
-/// convergence takes the error from ~tol to round-off). Also accepted: a round-off floor, i.e. the
-/// update is already ≤ 1e3·tol·‖x‖∞ and stopped shrinking by at least half.
+/// Convergence, on scaled updates δᵢ = ‖Δx⁽ⁱ⁾‖∞ / ‖x‖∞: stop when the error left after the update
+/// just applied is below tol. That error is estimated as δᵢ²/δᵢ₋₁ once the iteration contracts
+/// (δᵢ ≤ δᵢ₋₁/10): for quadratic convergence this bounds C δᵢ² from above, for linear convergence
+/// with rate ρ ≤ 0.1 it is ρ δᵢ, within 10 % of the true ρ δᵢ/(1 − ρ). So the accepted iterate is
+/// at the tolerance (1e-14: near machine precision) without an extra Newton iteration. Also
+/// accepted: δᵢ ≤ tol, and a round-off floor (δᵢ ≤ 1e3·tol and no longer halving).
 template <int N, class ResidualFactory, class S>
 int solve_newton(const ResidualFactory& make_residual, Eigen::Matrix<S, N, 1>& x, const NewtonSettings& settings,
                  double time, StepStatistics& statistics) {
@@ -114,9 +117,11 @@ int solve_newton(const ResidualFactory& make_residual, Eigen::Matrix<S, N, 1>& x
   Eigen::Matrix<double, N, 1> x_value = values_of(x);
   Jacobian jacobian;
   double previous_update = std::numeric_limits<double>::infinity();
-  bool converged = false;
   int iterations = 0;
-  Eigen::FullPivLU<Jacobian> lu;
+  Eigen::PartialPivLU<Jacobian> lu;
+  // |det J| relative to Hadamard's bound ∏ᵢ ‖Jᵢ‖₂ (≥ |det J|): a cheap, scale-invariant test of
+  // singularity for these small matrices [-].
+  constexpr double kSingularDeterminantRatio = 1e-14;
   while (true) {
     // F(x⁽ⁱ⁾) and J = ∂F/∂x (x⁽ⁱ⁾) in one forward-mode sweep, x seeded with the identity.
     JetVector x_jet;
@@ -136,11 +141,12 @@ int solve_newton(const ResidualFactory& make_residual, Eigen::Matrix<S, N, 1>& x
       throw StepError(newton_detail::describe_failure<N>("met a non-finite residual or Jacobian", time, iterations,
                                                          residual_norm));
     }
-    if (iterations >= settings.max_iterations + (converged ? 1 : 0)) {
+    if (iterations >= settings.max_iterations) {
       throw StepError(newton_detail::describe_failure<N>("did not converge", time, iterations, residual_norm));
     }
     lu.compute(jacobian);
-    if (!lu.isInvertible()) {
+    const double hadamard_bound = jacobian.rowwise().norm().prod();
+    if (!(std::abs(lu.determinant()) > kSingularDeterminantRatio * hadamard_bound)) {
       throw StepError(newton_detail::describe_failure<N>("met a singular Jacobian", time, iterations, residual_norm));
     }
     // x⁽ⁱ⁺¹⁾ ← x⁽ⁱ⁾ − J⁻¹ F(x⁽ⁱ⁾)
@@ -152,13 +158,14 @@ int solve_newton(const ResidualFactory& make_residual, Eigen::Matrix<S, N, 1>& x
       throw StepError(newton_detail::describe_failure<N>("produced a non-finite iterate", time, iterations,
                                                          residual_norm));
     }
-    if (converged) break;  // that was the one extra update: x is at round-off
     const double scale = std::max(x_value.template lpNorm<Eigen::Infinity>(), 1e-300);
-    const double scaled_update = update.template lpNorm<Eigen::Infinity>() / scale;
+    const double scaled_update = update.template lpNorm<Eigen::Infinity>() / scale;  // δᵢ
+    const bool contracting = std::isfinite(previous_update) && scaled_update <= 0.1 * previous_update;
+    const double remaining_error = contracting ? scaled_update * scaled_update / previous_update : scaled_update;
     const bool round_off_floor = scaled_update <= 1e3 * settings.tolerance && scaled_update > 0.5 * previous_update;
     previous_update = scaled_update;
-    if (round_off_floor) break;                          // stagnated at the round-off floor
-    if (scaled_update <= settings.tolerance) converged = true;  // one extra update follows
+    if (scaled_update <= settings.tolerance || remaining_error <= settings.tolerance) break;  // converged
+    if (round_off_floor) break;  // stagnated at the round-off floor
   }
   statistics.newton_iterations_last_step += static_cast<std::uint64_t>(iterations);
 
