@@ -99,6 +99,12 @@ CartSimParameters load_parameters(const ros::NodeHandle& private_node) {
   parameters.bag_path = read_parameter<std::string>(p, "bag_path", parameters.bag_path);
   parameters.bag_compression = read_parameter<std::string>(p, "bag_compression", parameters.bag_compression);
   BagRecorder::parse_compression(parameters.bag_compression);  // throws naming the bad value
+  // [bytes]; read as a number so sizes beyond a 32-bit XmlRpc int (2 GiB) can be given as 1.6e10.
+  const double min_free_disk_space =
+      read_double(p, "min_free_disk_space", static_cast<double>(parameters.min_free_disk_space));
+  require(std::isfinite(min_free_disk_space) && min_free_disk_space >= 0.0 && min_free_disk_space < 1.8e19,
+          "~min_free_disk_space must be >= 0 bytes (0 = no check)");
+  parameters.min_free_disk_space = static_cast<std::uint64_t>(min_free_disk_space);
   parameters.summary_path = read_parameter<std::string>(p, "summary_path", parameters.summary_path);
   parameters.frames.odom = read_parameter<std::string>(p, "odom_frame", parameters.frames.odom);
   parameters.frames.base_link = read_parameter<std::string>(p, "base_frame", parameters.frames.base_link);
@@ -171,7 +177,8 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   if (!parameters_.bag_path.empty()) {
     try {
       recorder_ = std::make_unique<BagRecorder>(parameters_.bag_path,
-                                                BagRecorder::parse_compression(parameters_.bag_compression));
+                                                BagRecorder::parse_compression(parameters_.bag_compression),
+                                                parameters_.min_free_disk_space);
     } catch (const std::exception& error) {
       throw NodeStartupError(std::string("cannot record (~bag_path): ") + error.what());
     }
@@ -226,6 +233,7 @@ int CartSimNode::run() {
       outcome = "interrupted (shutdown requested)";
       break;
     }
+    if (record_failure_) break;  // a command could not be recorded (set in a callback, also while paused)
     if (paused_) {
       process_callbacks(0.02);
       pace_anchor_wall_ = ros::WallTime::now();
@@ -271,11 +279,16 @@ int CartSimNode::run() {
     outcome = "step failure: " + *step_failure_;
     diagnostic_updater_->force_update();
   }
+  if (record_failure_) {
+    ROS_ERROR("cart_sim: bag write failed at t = %.9g s, stopping (the node does not run without its record): %s",
+              simulation_->state().time, record_failure_->c_str());
+  }
   if (recorder_) {
     try {
       recorder_->close();
     } catch (const std::exception& error) {
-      record_failure_ = error.what();
+      // Keep the first cause (the failed write); the close failure follows it.
+      record_failure_ = record_failure_ ? *record_failure_ + "; then " + error.what() : std::string(error.what());
     }
   }
   if (record_failure_) {
@@ -330,7 +343,7 @@ void CartSimNode::publish_instant() {
     last_transform_stamp_ = odometry.header.stamp;
   }
   ++published_instants_;
-  if (recorder_) {
+  if (recorder_ && !record_failure_) {
     try {
       recorder_->write(integration_error_publisher_.getTopic(), error.header.stamp, error);
       recorder_->write(odometry_publisher_.getTopic(), odometry.header.stamp, odometry);
@@ -529,7 +542,7 @@ void CartSimNode::write_summary(const std::string& outcome) {
        << stepping_wall_time_ << " s), real-time factor " << (wall_time > 0.0 ? simulated_time_ / wall_time : 0.0)
        << ". Published instants: " << published_instants_ << ".";
   if (recorder_) {
-    text << " Bag: " << recorder_->path() << " (";
+    text << " Bag: " << recorder_->current_path() << (record_failure_ ? " (unfinished; " : " (");
     bool first = true;
     for (const auto& [topic, count] : recorder_->message_counts()) {
       text << (first ? "" : ", ") << topic << ": " << count;

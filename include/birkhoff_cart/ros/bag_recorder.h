@@ -1,6 +1,10 @@
 // The node's own record: a compressed rosbag written through the rosbag C++ API. While open the
 // bag is "<path>.active" (like `rosbag record`); close() renames it to <path>, so a bag at <path>
 // is always complete and readable by `rosbag info` and python rosbag.
+//
+// Disk space: before opening, the recorder can refuse a directory with less free space than a
+// minimum (cart_sim's ~min_free_disk_space), so a node never starts a record it cannot keep. A disk
+// that fills during the run makes write() throw; close() then closes what it can.
 #pragma once
 
 #include <cstdint>
@@ -20,13 +24,28 @@ class BagRecorderError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The directory that holds `bag_path` ("." for a bare file name, "/" for a file at the root).
+std::string bag_directory(const std::string& bag_path);
+
+/// The decision of the free-space check (pure): "" when `free_bytes` ≥ `min_free_bytes` or
+/// `min_free_bytes` is 0 (check disabled); otherwise a message naming `directory`, the free bytes
+/// and the required minimum [bytes].
+std::string disk_space_shortage(const std::string& directory, std::uint64_t free_bytes,
+                                std::uint64_t min_free_bytes);
+
+/// Bytes an unprivileged writer may still use on the file system holding `directory`
+/// (statvfs: f_bavail × f_frsize). Throws BagRecorderError naming the directory when statvfs fails.
+std::uint64_t free_disk_space(const std::string& directory);
+
 class BagRecorder {
  public:
   enum class Compression { kNone, kLz4, kBz2 };
 
   /// Opens "<path>.active" for writing. Throws BagRecorderError when it cannot (missing or
-  /// unwritable directory, empty path, ...).
-  BagRecorder(const std::string& path, Compression compression = Compression::kLz4);
+  /// unwritable directory, empty path, ...) or, with `min_free_disk_space` > 0 [bytes], when the
+  /// bag's directory has less free space than that (checked before anything is created).
+  BagRecorder(const std::string& path, Compression compression = Compression::kLz4,
+              std::uint64_t min_free_disk_space = 0);
   /// Closes the bag (see close()); never throws.
   ~BagRecorder();
   BagRecorder(const BagRecorder&) = delete;
@@ -40,12 +59,15 @@ class BagRecorder {
     try {
       bag_->write(topic, time < ros::TIME_MIN ? ros::TIME_MIN : time, message);
     } catch (const std::exception& error) {
-      throw BagRecorderError("cannot write " + topic + " to bag " + active_path() + ": " + error.what());
+      throw BagRecorderError("cannot write " + topic + " to bag " + active_path() + ": " + error.what() +
+                             free_space_note());
     }
     ++message_counts_[topic];
   }
 
-  /// Flushes, closes and renames the bag to its final path. Idempotent.
+  /// Flushes, closes and renames the bag to its final path. Idempotent. Throws BagRecorderError
+  /// when rosbag cannot finish the file (e.g. the disk is full): the bag then stays
+  /// "<path>.active" with the chunks already on disk (`rosbag reindex` may recover them).
   void close();
   bool is_open() const { return open_; }
 
@@ -53,6 +75,9 @@ class BagRecorder {
   const std::string& path() const { return path_; }
   /// The path written while open.
   std::string active_path() const { return path_ + ".active"; }
+  /// Where the bag is now: path() after a successful close(), active_path() otherwise (still
+  /// open, or left unfinished by a failed close).
+  std::string current_path() const { return finished_ ? path_ : active_path(); }
   /// Messages written per topic.
   const std::map<std::string, std::uint64_t>& message_counts() const { return message_counts_; }
 
@@ -60,9 +85,14 @@ class BagRecorder {
   static Compression parse_compression(const std::string& name);
 
  private:
+  /// " (N bytes free in DIR)" after a failed write: rosbag's own messages ("Error seeking",
+  /// "Problem writing data to disk") do not say that the disk is full. "" when statvfs fails.
+  std::string free_space_note() const;
+
   std::string path_;
   std::unique_ptr<rosbag::Bag> bag_;
   bool open_ = false;
+  bool finished_ = false;  ///< closed and renamed to path_
   std::map<std::string, std::uint64_t> message_counts_;
 };
 

@@ -43,6 +43,7 @@ struct CartSimParameters {
   double max_drive_torque = 200.0;           ///< ~max_drive_torque: clamp [N·m]
   std::string bag_path;                      ///< ~bag_path: record here; "" = no record
   std::string bag_compression = "lz4";       ///< ~bag_compression: lz4, bz2 or none
+  std::uint64_t min_free_disk_space = 16u << 20;  ///< ~min_free_disk_space: refuse to record below [bytes]; 0 = no check
   std::string summary_path;                  ///< ~summary_path: also write the final summary here; "" = no file
   ros_conversions::FrameNames frames;        ///< ~odom_frame, ~base_frame
   bool publish_tf = true;                    ///< ~publish_tf: odom → base_link on /tf
