@@ -3,8 +3,8 @@
 # executable from the repository, then plot and tabulate with Debian's python3-matplotlib.
 #
 # Usage: scripts/run_benchmark.sh [--quick] [more work_precision options]
-#   default: ~10 minutes on a quiet 2-core machine; writes bench/results/*.csv, *.png, work_precision.md
-#   --quick: ~5 s smoke run (3 repetitions, jackknife_whirl 100 s, fewer step sizes) into
+#   default: ~2½ minutes on a quiet 2-core machine (measured); writes bench/results/*.csv, *.png, work_precision.md
+#   --quick: ~2 s smoke run (3 repetitions, jackknife_whirl 100 s, fewer step sizes) into
 #            /tmp/birkhoff_cart_bench_quick unless --output-dir is given
 # Environment: BIRKHOFF_CART_WORKSPACE = an already-built catkin workspace to use instead of
 #              running scripts/setup.sh (which builds .ws/).
