@@ -9,14 +9,8 @@
 # Environment: BIRKHOFF_CART_WORKSPACE = an already-built catkin workspace to use instead of
 #              running scripts/setup.sh (which builds .ws/).
 set -euo pipefail
-repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-export PATH="/usr/bin:/bin:$PATH"
-
-workspace="${BIRKHOFF_CART_WORKSPACE:-}"
-if [ -z "$workspace" ]; then
-  "$repo/scripts/setup.sh"
-  workspace="$repo/.ws"
-fi
+# shellcheck source=scripts/workspace.sh
+source "$(dirname "${BASH_SOURCE[0]}")/workspace.sh"  # → $repo, $workspace (set up and built)
 binary="$workspace/devel/lib/birkhoff_cart/work_precision"
 if [ ! -x "$binary" ]; then
   echo "run_benchmark.sh: $binary not built" >&2

@@ -8,15 +8,8 @@
 # Developers with their own built workspace: BIRKHOFF_CART_WORKSPACE=/path/to/ws skips set-up and
 # uses that workspace instead of .ws/.
 set -euo pipefail
-repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-# Debian's python3 (with the ROS modules) must win over the pyenv interpreter on PATH.
-export PATH="/usr/bin:/bin:$PATH"
-
-workspace="${BIRKHOFF_CART_WORKSPACE:-}"
-if [ -z "$workspace" ]; then
-  "$repo/scripts/setup.sh"
-  workspace="$repo/.ws"
-fi
+# shellcheck source=scripts/workspace.sh
+source "$(dirname "${BASH_SOURCE[0]}")/workspace.sh"  # → $repo, $workspace (set up and built)
 
 set +u  # catkin's setup files read unset variables
 # shellcheck disable=SC1091
