@@ -153,6 +153,12 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   }
 
   const double start_time = simulation_->state().time;
+  // Scene time t is ROS time t, and ROS time cannot be negative: refuse here, not at the first
+  // /clock (which would end the run in std::terminate with the bag left unfinished).
+  if (!(start_time >= 0.0)) {
+    throw NodeStartupError("scene " + parameters_.scene_path + " starts at t = " + format_seconds(start_time) +
+                           " s: cart_sim publishes scene time as ROS time, which must be >= 0");
+  }
   if (parameters_.duration < 0.0) {
     end_time_ = simulation_->end_time();
   } else if (parameters_.duration == 0.0 || std::isinf(parameters_.duration)) {

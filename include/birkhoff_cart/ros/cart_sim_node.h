@@ -78,7 +78,8 @@ class CartSimNode {
   /// Exit codes of run().
   static constexpr int kExitFinished = 0;     ///< duration reached or shutdown requested
   static constexpr int kExitStepFailure = 1;  ///< a StepError stopped the simulation
-  static constexpr int kExitRecordFailure = 3;///< the bag could not be written
+  static constexpr int kExitStartupFailure = 2;  ///< the constructor threw NodeStartupError (main's exit)
+  static constexpr int kExitRecordFailure = 3;   ///< the bag could not be written
 
   /// Loads parameters and scene, builds the simulation, opens the bag, advertises. Throws
   /// NodeStartupError with a message naming the problem.

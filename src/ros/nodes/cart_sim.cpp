@@ -14,6 +14,6 @@ int main(int argc, char** argv) {
     return node.run();
   } catch (const birkhoff_cart::NodeStartupError& error) {
     ROS_FATAL("cart_sim: %s", error.what());
-    return 2;
+    return birkhoff_cart::CartSimNode::kExitStartupFailure;
   }
 }
