@@ -61,6 +61,18 @@ std::string format_seconds(double value) {
   return text.str();
 }
 
+// One schedule of instants start + k·period [s], k = index, index + 1, ...: advances `index` past
+// every instant at or before `time` + `margin` [s] (half a step, so round-off in t does not move an
+// instant to the next step). True when at least one instant was passed.
+bool pass_due_instants(double start, double period, double time, double margin, std::uint64_t& index) {
+  bool passed = false;
+  while (start + static_cast<double>(index) * period <= time + margin) {
+    passed = true;
+    ++index;
+  }
+  return passed;
+}
+
 }  // namespace
 
 void install_shutdown_signal_handlers() {
@@ -264,13 +276,8 @@ int CartSimNode::run() {
     simulated_time_ += simulation_->state().time - time_before;
 
     const double time = simulation_->state().time;
-    const double start_time = simulation_->scene().initial_state.time;
-    const double half_step = 0.5 * simulation_->step_size();
-    bool publish_due = false;
-    while (start_time + static_cast<double>(next_publish_index_) * publish_period_ <= time + half_step) {
-      publish_due = true;
-      ++next_publish_index_;
-    }
+    const bool publish_due = pass_due_instants(simulation_->scene().initial_state.time, publish_period_, time,
+                                               0.5 * simulation_->step_size(), next_publish_index_);
     if (!clock_started_ || publish_due) publish_clock(time);
     clock_started_ = true;
     if (publish_due) {
@@ -358,13 +365,8 @@ void CartSimNode::publish_instant() {
       record_failure_ = failure.what();
     }
   }
-  const double start_time = simulation_->scene().initial_state.time;
-  if (start_time + static_cast<double>(next_diagnostic_index_) * parameters_.diagnostic_period <=
-      state.time + 0.5 * simulation_->step_size()) {
-    while (start_time + static_cast<double>(next_diagnostic_index_) * parameters_.diagnostic_period <=
-           state.time + 0.5 * simulation_->step_size()) {
-      ++next_diagnostic_index_;
-    }
+  if (pass_due_instants(simulation_->scene().initial_state.time, parameters_.diagnostic_period, state.time,
+                        0.5 * simulation_->step_size(), next_diagnostic_index_)) {
     diagnostic_updater_->force_update();
   }
 }
