@@ -65,12 +65,13 @@ class CartBirkhoffianBase {
                                   Vector2<S>(z(kForwardMomentumIndex), z(kSteeringMomentumIndex)));
   }
 
-  /// Q = (Q1 [N], Q2 [N·m]) of the enabled loads; zero when the non-Birkhoffian force is disabled.
+  /// Q = (Q1 [N], Q2 [N·m]) of the enabled loads at χ [rad] and ω = M(χ)⁻¹ p [m/s, rad/s] (the
+  /// caller's, so that one evaluation of the right-hand side solves M ω = p once); zero when the
+  /// non-Birkhoffian force is disabled.
   template <class S>
-  Vector2<S> generalized_force(const Vector<S>& z, const S& t) const {
-    const Vector2<S> omega = quasi_velocity(z);
+  Vector2<S> generalized_force(const S& steering_angle, const Vector2<S>& omega, const S& t) const {
     if (!non_birkhoffian_force_enabled_) return Vector2<S>(S(0.0) * omega(0), S(0.0) * omega(0));
-    return effects_->generalized_force(value_of(t), z(kSteeringAngleIndex), omega);
+    return effects_->generalized_force(value_of(t), steering_angle, omega);
   }
 
   /// H̃ = ½ pᵀ M(χ)⁻¹ p = T* [J].
@@ -92,12 +93,11 @@ class CartBirkhoffianBase {
     return gradient;
   }
 
-  /// The physical momentum rate ṗ = ∂T*/∂q|_ω + Λ_nh + Q (eq. (3.6)) [N, N·m].
+  /// The physical momentum rate ṗ = ∂T*/∂q|_ω + Λ_nh + Q (eq. (3.6)) [N, N·m] at χ [rad] and
+  /// ω = M(χ)⁻¹ p [m/s, rad/s].
   template <class S>
-  Vector2<S> momentum_rate(const Vector<S>& z, const S& t) const {
-    const Vector2<S> omega = quasi_velocity(z);
-    const S& chi = z(kSteeringAngleIndex);
-    Vector2<S> rate = model_->nonholonomic_force(chi, omega) + generalized_force(z, t);
+  Vector2<S> momentum_rate(const S& chi, const Vector2<S>& omega, const S& t) const {
+    Vector2<S> rate = model_->nonholonomic_force(chi, omega) + generalized_force(chi, omega, t);
     rate(1) += model_->kinetic_energy_steering_derivative(chi, omega);
     return rate;
   }
@@ -108,7 +108,7 @@ class CartBirkhoffianBase {
   Passive<S> passive_rates(const Vector<S>& z, const Passive<S>& y, const S& t) const {
     const Vector2<S> omega = quasi_velocity(z);
     const CoordinateRates<S> rates = model_->coordinate_rates(y(kHeadingIndex), z(kSteeringAngleIndex), omega);
-    const Vector2<S> force = generalized_force(z, t);
+    const Vector2<S> force = generalized_force(z(kSteeringAngleIndex), omega, t);
     Passive<S> rate;
     rate(kXIndex) = rates.x_rate;
     rate(kYIndex) = rates.y_rate;
@@ -176,7 +176,8 @@ class CartAutonomousBirkhoffian : public CartBirkhoffianBase {
     Vector<S> force = Vector<S>::Constant(cart_birkhoffian_detail::zero_like(z(0)));
     if (!non_birkhoffian_force_enabled_) return force;
     const Vector2<S> omega = quasi_velocity(z);
-    const Vector2<S> load = model_->nonholonomic_force(z(kSteeringAngleIndex), omega) + generalized_force(z, t);
+    const S& chi = z(kSteeringAngleIndex);
+    const Vector2<S> load = model_->nonholonomic_force(chi, omega) + generalized_force(chi, omega, t);
     force(kArcLengthIndex) = -load(0);
     force(kSteeringAngleIndex) = -load(1);
     return force;
@@ -198,7 +199,7 @@ class CartAutonomousBirkhoffian : public CartBirkhoffianBase {
     rate(kArcLengthIndex) = omega(0);
     rate(kSteeringAngleIndex) = omega(1);
     if (non_birkhoffian_force_enabled_) {
-      const Vector2<S> p_rate = momentum_rate(w, t);
+      const Vector2<S> p_rate = momentum_rate(w(kSteeringAngleIndex), omega, t);
       rate(kForwardMomentumIndex) = p_rate(0);
       rate(kSteeringMomentumIndex) = p_rate(1);
     } else {
@@ -265,7 +266,8 @@ class CartPaperBirkhoffian : public CartBirkhoffianBase {
     if (!non_birkhoffian_force_enabled_) return force;
     const S e = conformal_factor(t);
     const Vector2<S> omega = quasi_velocity(z);
-    const Vector2<S> load = model_->nonholonomic_force(z(kSteeringAngleIndex), omega) + generalized_force(z, t);
+    const S& chi = z(kSteeringAngleIndex);
+    const Vector2<S> load = model_->nonholonomic_force(chi, omega) + generalized_force(chi, omega, t);
     force(kArcLengthIndex) = -e * (load(0) + z(kForwardMomentumIndex));
     force(kSteeringAngleIndex) = -e * (load(1) + z(kSteeringMomentumIndex));
     return force;
@@ -298,7 +300,7 @@ class CartPaperBirkhoffian : public CartBirkhoffianBase {
     rate(kArcLengthIndex) = omega(0);
     rate(kSteeringAngleIndex) = omega(1);
     if (non_birkhoffian_force_enabled_) {
-      const Vector2<S> p_rate = momentum_rate(z, t);
+      const Vector2<S> p_rate = momentum_rate(z(kSteeringAngleIndex), omega, t);
       rate(kForwardMomentumIndex) = e * (p_rate(0) + z(kForwardMomentumIndex));
       rate(kSteeringMomentumIndex) = e * (p_rate(1) + z(kSteeringMomentumIndex));
     } else {
