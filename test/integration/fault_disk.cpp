@@ -34,21 +34,11 @@ constexpr double kEndTolerance = 1.0;   // [s of scene time]: "before the end" m
 constexpr double kDefaultMinimum = 16.0 * 1024 * 1024;  // cart_sim's default ~min_free_disk_space [bytes]
 
 using birkhoff_cart_test::file_exists;
+using birkhoff_cart_test::file_size;
+using birkhoff_cart_test::read_file;
 using birkhoff_cart_test::run_command;
 using birkhoff_cart_test::start_cart_sim;
 using birkhoff_cart_test::wait_exit;
-
-std::string read_file(const std::string& path) {
-  std::ifstream file(path);
-  std::stringstream text;
-  text << file.rdbuf();
-  return text.str();
-}
-
-long file_size(const std::string& path) {
-  struct stat info;
-  return ::stat(path.c_str(), &info) == 0 ? static_cast<long>(info.st_size) : -1;
-}
 
 std::vector<std::string> directory_entries(const std::string& directory) {
   std::vector<std::string> names;

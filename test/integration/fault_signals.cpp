@@ -38,21 +38,11 @@ constexpr double kPublishRate = 100.0;    // cart_sim's default ~publish_rate [H
 constexpr double kStampTolerance = 1e-6;  // [s]; stamps are t0 + k/rate in ROS time (ns)
 
 using birkhoff_cart_test::file_exists;
+using birkhoff_cart_test::file_size;
+using birkhoff_cart_test::read_file;
 using birkhoff_cart_test::run_command;
 using birkhoff_cart_test::start_cart_sim;
 using birkhoff_cart_test::wait_exit;
-
-long file_size(const std::string& path) {
-  struct stat info;
-  return ::stat(path.c_str(), &info) == 0 ? static_cast<long>(info.st_size) : -1;
-}
-
-std::string read_file(const std::string& path) {
-  std::ifstream file(path);
-  std::stringstream text;
-  text << file.rdbuf();
-  return text.str();
-}
 
 std::string scene_parameter() {
   std::string scene;

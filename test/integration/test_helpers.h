@@ -1,6 +1,7 @@
 // Small helpers shared by the rostest nodes: waiting on a condition while spinning (wall-clock
 // timeouts only guard against hangs; the conditions are messages and sim time), and running a
-// second cart_sim as a child process (start, wait for its exit) with the files it leaves behind.
+// second cart_sim as a child process (start, wait for its exit) with the files it leaves behind
+// (existence, size, text).
 #pragma once
 
 #include <fcntl.h>
@@ -11,7 +12,9 @@
 
 #include <array>
 #include <cstdio>
+#include <fstream>
 #include <functional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -94,6 +97,20 @@ inline int wait_exit(pid_t pid, double timeout) {
 inline bool file_exists(const std::string& path) {
   struct stat info;
   return ::stat(path.c_str(), &info) == 0;
+}
+
+/// Size of the file at `path` [bytes]; −1 when it does not exist.
+inline long file_size(const std::string& path) {
+  struct stat info;
+  return ::stat(path.c_str(), &info) == 0 ? static_cast<long>(info.st_size) : -1;
+}
+
+/// The whole text of the file at `path` ("" when it cannot be read).
+inline std::string read_file(const std::string& path) {
+  std::ifstream file(path);
+  std::stringstream text;
+  text << file.rdbuf();
+  return text.str();
 }
 
 /// Runs the shell `command` with stderr merged into stdout, appends what it printed to `output`,
