@@ -97,9 +97,7 @@ class CartBirkhoffianBase {
   /// ω = M(χ)⁻¹ p [m/s, rad/s].
   template <class S>
   Vector2<S> momentum_rate(const S& chi, const Vector2<S>& omega, const S& t) const {
-    Vector2<S> rate = model_->nonholonomic_force(chi, omega) + generalized_force(chi, omega, t);
-    rate(1) += model_->kinetic_energy_steering_derivative(chi, omega);
-    return rate;
+    return model_->momentum_rate(chi, omega, generalized_force(chi, omega, t));
   }
 
   /// ẏ = g(z, y, t) = (ẋ, ẏ, θ̇, φ̇1..φ̇4, ω·Q, Q2) (eqs. (2.3)–(2.4), (3.7)). Reads only the heading

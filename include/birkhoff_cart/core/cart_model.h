@@ -111,6 +111,25 @@ class CartModel {
     return inertia_.mu1 * s * c * w1 * w1 + inertia_.nu * c * w1 * w2;
   }
 
+  /// ṗ = ∂T*/∂q|_ω + Λ_nh + Q summed in closed form (eq. (3.6)): the χ-row of ∂T*/∂q|_ω cancels
+  /// that of Λ_nh, so ṗ1 = Q1 + μ1 s c ω1 ω2 + ν c ω2² [N] and ṗ2 = Q2 [N·m] exactly (eq. (3.8)).
+  /// One sin/cos of χ instead of one in each of nonholonomic_force and
+  /// kinetic_energy_steering_derivative, and no cancellation in ṗ2.
+  template <class Scalar>
+  Vector2<Scalar> momentum_rate(const Scalar& steering_angle, const Vector2<Scalar>& quasi_velocity,
+                                const Vector2<Scalar>& generalized_force) const {
+    using std::cos;
+    using std::sin;
+    const Scalar s = sin(steering_angle);
+    const Scalar c = cos(steering_angle);
+    const Scalar& w1 = quasi_velocity(0);
+    const Scalar& w2 = quasi_velocity(1);
+    Vector2<Scalar> rate;
+    rate(0) = (inertia_.mu1 * s * c * w1 * w2 + inertia_.nu * c * w2 * w2) + generalized_force(0);  // Λ_nh,1 + Q1
+    rate(1) = generalized_force(1);
+    return rate;
+  }
+
   /// Boltzmann–Hamel equations solved for ω̇ (eq. (3.4)):
   ///   M(χ) ω̇ = Q − h(χ, ω),   h = (μ1 s c ω1 ω2,  ν c ω1 ω2).
   template <class Scalar>
