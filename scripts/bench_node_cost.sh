@@ -15,7 +15,9 @@ set +u
 # shellcheck disable=SC1091
 source "$workspace/devel/setup.bash"
 set -u
-port=$((20000 + RANDOM % 10000))
+# A free port (as scripts/run_main.sh): a random one could be another master's, which would then
+# answer below and get our /use_sim_time and nodes.
+port="$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("", 0)); print(s.getsockname()[1])')"
 export ROS_MASTER_URI="http://localhost:$port"
 export ROS_LOG_DIR="$(mktemp -d /tmp/birkhoff_cart_node_cost.XXXXXX)"
 scene="$repo/config/scenes/default.yaml"
@@ -27,6 +29,10 @@ roscore -p "$port" > "$work/roscore.log" 2>&1 &
 roscore_pid=$!
 trap 'kill "$roscore_pid" 2>/dev/null || true; wait "$roscore_pid" 2>/dev/null || true' EXIT
 for _ in $(seq 50); do rosparam list > /dev/null 2>&1 && break; sleep 0.2; done
+if ! kill -0 "$roscore_pid" 2>/dev/null; then
+  echo "bench_node_cost.sh: roscore on port $port did not start (see $work/roscore.log)" >&2
+  exit 1
+fi
 rosparam set /use_sim_time true
 
 # The default scene without its shadow reference (everything else identical).
