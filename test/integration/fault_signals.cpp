@@ -155,6 +155,30 @@ TEST(FaultSignals, UnwritableBagPathStopsTheNodeWithAMessageNamingIt) {
   std::remove(log.c_str());
 }
 
+TEST(FaultSignals, SceneStartingAtNegativeTimeStopsTheNodeAtStartWithExit2) {
+  // Scene time is published as ROS time, which cannot be negative: the node must refuse at start
+  // (exit 2, README "Exit codes"), not abort at its first /clock with the bag left unfinished.
+  std::string scene = read_file(scene_parameter());
+  const std::string start_line = "\n  time: 0.0";  // initial_state.time of driven.yaml
+  const std::size_t at = scene.find(start_line);
+  ASSERT_NE(at, std::string::npos) << "no initial_state time line in " << scene_parameter();
+  scene.replace(at, start_line.size(), "\n  time: -0.5");
+  const std::string scene_path = scratch("negative_start.yaml");
+  std::ofstream(scene_path) << scene;
+  const std::string bag_path = scratch("negative_start.bag");
+  const std::string log = scratch("negative_start.log");
+  const pid_t pid = start_cart_sim(
+      {"__name:=negative_start_sim", "_scene:=" + scene_path, "_bag_path:=" + bag_path, "_fast:=true"}, log);
+  ASSERT_GT(pid, 0);
+  EXPECT_EQ(wait_exit(pid, 30.0), 2) << read_file(log);
+  EXPECT_NE(read_file(log).find("starts at t = -0.5 s"), std::string::npos) << read_file(log);
+  EXPECT_FALSE(file_exists(bag_path + ".active")) << "a bag was opened for a run that cannot start";
+  EXPECT_FALSE(file_exists(bag_path));
+  std::remove((bag_path + ".active").c_str());
+  std::remove(log.c_str());
+  std::remove(scene_path.c_str());
+}
+
 /// Runs the driven scene for 2 s of scene time, the same commands sent while it is paused.
 std::string recorded_run(const std::string& name) {
   const std::string bag_path = scratch(name + ".bag");
