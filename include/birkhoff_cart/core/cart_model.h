@@ -71,12 +71,7 @@ class CartModel {
   /// ω = M(χ)⁻¹ p (closed-form 2×2 inverse; singular only in the paper's case at χ = kπ).
   template <class Scalar>
   Vector2<Scalar> quasi_velocity(const Scalar& steering_angle, const Vector2<Scalar>& momentum) const {
-    const Matrix2<Scalar> mass = mass_matrix(steering_angle);
-    const Scalar determinant = mass(0, 0) * mass(1, 1) - mass(0, 1) * mass(1, 0);
-    Vector2<Scalar> velocity;
-    velocity(0) = (mass(1, 1) * momentum(0) - mass(0, 1) * momentum(1)) / determinant;
-    velocity(1) = (mass(0, 0) * momentum(1) - mass(1, 0) * momentum(0)) / determinant;
-    return velocity;
+    return solve_mass(mass_matrix(steering_angle), momentum);
   }
 
   /// Nonholonomic (gyroscopic) force of the canonical form (eq. (3.6)):
@@ -143,12 +138,7 @@ class CartModel {
     Vector2<Scalar> right_hand_side;
     right_hand_side(0) = generalized_force(0) - inertia_.mu1 * s * coupling;
     right_hand_side(1) = generalized_force(1) - inertia_.nu * coupling;
-    const Matrix2<Scalar> mass = mass_matrix(steering_angle);
-    const Scalar determinant = mass(0, 0) * mass(1, 1) - mass(0, 1) * mass(1, 0);
-    Vector2<Scalar> acceleration;
-    acceleration(0) = (mass(1, 1) * right_hand_side(0) - mass(0, 1) * right_hand_side(1)) / determinant;
-    acceleration(1) = (mass(0, 0) * right_hand_side(1) - mass(1, 0) * right_hand_side(0)) / determinant;
-    return acceleration;
+    return solve_mass(mass_matrix(steering_angle), right_hand_side);
   }
 
   /// Rim speed coefficients of the four wheels, r_i φ̇_i = d1_i ω1 + d2_i ω2   (eq. (2.4)):
@@ -212,6 +202,16 @@ class CartModel {
   double max_constraint_residual(const CartState& state) const;
 
  private:
+  /// M⁻¹ b by the closed-form 2×2 inverse (Cramer's rule).
+  template <class Scalar>
+  static Vector2<Scalar> solve_mass(const Matrix2<Scalar>& mass, const Vector2<Scalar>& b) {
+    const Scalar determinant = mass(0, 0) * mass(1, 1) - mass(0, 1) * mass(1, 0);
+    Vector2<Scalar> solution;
+    solution(0) = (mass(1, 1) * b(0) - mass(0, 1) * b(1)) / determinant;
+    solution(1) = (mass(0, 0) * b(1) - mass(1, 0) * b(0)) / determinant;
+    return solution;
+  }
+
   CartParameters parameters_;
   ReducedInertia inertia_;
   InertiaModel inertia_model_;
