@@ -85,12 +85,7 @@ class CartModel {
     using std::sin;
     const Scalar s = sin(steering_angle);
     const Scalar c = cos(steering_angle);
-    const Scalar& w1 = quasi_velocity(0);
-    const Scalar& w2 = quasi_velocity(1);
-    Vector2<Scalar> force;
-    force(0) = inertia_.mu1 * s * c * w1 * w2 + inertia_.nu * c * w2 * w2;
-    force(1) = -inertia_.mu1 * s * c * w1 * w1 - inertia_.nu * c * w1 * w2;
-    return force;
+    return nonholonomic_force_at(s, c, quasi_velocity);
   }
 
   /// ∂T*/∂χ at constant ω = μ1 s c ω1² + ν c ω1 ω2 [J/rad] (= −∂H̃/∂χ at constant p).
@@ -99,11 +94,10 @@ class CartModel {
                                             const Vector2<Scalar>& quasi_velocity) const {
     using std::cos;
     using std::sin;
+    // ∂T*/∂χ|_ω = −Λ_nh,2 exactly (negation is exact in floating point).
     const Scalar s = sin(steering_angle);
     const Scalar c = cos(steering_angle);
-    const Scalar& w1 = quasi_velocity(0);
-    const Scalar& w2 = quasi_velocity(1);
-    return inertia_.mu1 * s * c * w1 * w1 + inertia_.nu * c * w1 * w2;
+    return -nonholonomic_force_at(s, c, quasi_velocity)(1);
   }
 
   /// ṗ = ∂T*/∂q|_ω + Λ_nh + Q summed in closed form (eq. (3.6)): the χ-row of ∂T*/∂q|_ω cancels
@@ -117,10 +111,8 @@ class CartModel {
     using std::sin;
     const Scalar s = sin(steering_angle);
     const Scalar c = cos(steering_angle);
-    const Scalar& w1 = quasi_velocity(0);
-    const Scalar& w2 = quasi_velocity(1);
     Vector2<Scalar> rate;
-    rate(0) = (inertia_.mu1 * s * c * w1 * w2 + inertia_.nu * c * w2 * w2) + generalized_force(0);  // Λ_nh,1 + Q1
+    rate(0) = nonholonomic_force_at(s, c, quasi_velocity)(0) + generalized_force(0);  // Λ_nh,1 + Q1
     rate(1) = generalized_force(1);
     return rate;
   }
@@ -202,6 +194,18 @@ class CartModel {
   double max_constraint_residual(const CartState& state) const;
 
  private:
+  /// Λ_nh of eq. (3.6) from s = sin χ, c = cos χ (computed once by the caller):
+  ///   ( μ1 s c ω1 ω2 + ν c ω2²,  −μ1 s c ω1² − ν c ω1 ω2 ).
+  template <class Scalar>
+  Vector2<Scalar> nonholonomic_force_at(const Scalar& s, const Scalar& c, const Vector2<Scalar>& quasi_velocity) const {
+    const Scalar& w1 = quasi_velocity(0);
+    const Scalar& w2 = quasi_velocity(1);
+    Vector2<Scalar> force;
+    force(0) = inertia_.mu1 * s * c * w1 * w2 + inertia_.nu * c * w2 * w2;
+    force(1) = -inertia_.mu1 * s * c * w1 * w1 - inertia_.nu * c * w1 * w2;
+    return force;
+  }
+
   /// M⁻¹ b by the closed-form 2×2 inverse (Cramer's rule).
   template <class Scalar>
   static Vector2<Scalar> solve_mass(const Matrix2<Scalar>& mass, const Vector2<Scalar>& b) {
