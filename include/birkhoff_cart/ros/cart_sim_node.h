@@ -7,6 +7,10 @@
 // first /clock is one step after the start (t0 + h), never 0. Fast mode runs as fast as possible
 // (or at ~real_time_factor); real-time mode is paced by the wall clock. Between steps the node
 // processes its callbacks, so commands take effect at deterministic scene times.
+//
+// The member functions are defined by job: cart_sim_node.cpp (construction and the time loop),
+// cart_sim_pacing.cpp, cart_sim_publishing.cpp, cart_sim_services.cpp (commands, ~reset, ~pause)
+// and cart_sim_summary.cpp (diagnostics and the final summary).
 #pragma once
 
 #include <atomic>
@@ -24,54 +28,18 @@
 
 #include "birkhoff_cart/core/simulation.h"
 #include "birkhoff_cart/ros/bag_recorder.h"
+#include "birkhoff_cart/ros/cart_sim_parameters.h"
 #include "birkhoff_cart/ros/command_channel.h"
 #include "birkhoff_cart/ros/conversions.h"
+#include "birkhoff_cart/ros/shutdown_signals.h"
 
 namespace birkhoff_cart {
-
-/// Every private parameter of cart_sim, with its default (README.md, "ROS interface").
-struct CartSimParameters {
-  std::string scene_path;                    ///< ~scene: scene YAML (required)
-  std::string integrator;                    ///< ~integrator: registry name; "" = the scene's
-  double step_size = 0.0;                    ///< ~step_size: h [s]; 0 = the scene's
-  double publish_rate = 100.0;               ///< ~publish_rate: [Hz of scene time]
-  bool fast = false;                         ///< ~fast: lockstep as fast as possible (true) or real time
-  double real_time_factor = 0.0;             ///< ~real_time_factor: [-]; 0 = unlimited (fast) / 1 (real time)
-  double duration = -1.0;                    ///< ~duration: [s]; < 0 = the scene's; 0 = until shutdown
-  double command_timeout = 0.5;              ///< ~command_timeout: watchdog silence [s of scene time]; 0 = off
-  double max_steering_torque = 100.0;        ///< ~max_steering_torque: clamp [N·m]
-  double max_drive_torque = 200.0;           ///< ~max_drive_torque: clamp [N·m]
-  std::string bag_path;                      ///< ~bag_path: record here; "" = no record
-  std::string bag_compression = "lz4";       ///< ~bag_compression: lz4, bz2 or none
-  std::uint64_t min_free_disk_space = 16u << 20;  ///< ~min_free_disk_space: refuse to record below [bytes]; 0 = no check
-  std::string summary_path;                  ///< ~summary_path: also write the final summary here; "" = no file
-  ros_conversions::FrameNames frames;        ///< ~odom_frame, ~base_frame
-  bool publish_tf = true;                    ///< ~publish_tf: odom → base_link on /tf
-  bool publish_clock = true;                 ///< ~publish_clock: the node drives /clock
-  bool start_paused = false;                 ///< ~start_paused: wait for ~pause(false) before stepping
-  double diagnostic_period = 1.0;            ///< ~diagnostic_period: /diagnostics every [s of scene time]
-  double energy_residual_warn = 1e-4;        ///< ~energy_residual_warn: |T* − T*₀ − W| [J]
-  double energy_residual_error = 1e-1;       ///< ~energy_residual_error: [J]
-  double p2_residual_warn = 1e-8;            ///< ~p2_residual_warn: |p2 − p2₀ − I2| [N·m·s]
-  double p2_residual_error = 1e-5;           ///< ~p2_residual_error: [N·m·s]
-  double constraint_residual_warn = 1e-9;    ///< ~constraint_residual_warn: max |(15)| [m/s]
-  double constraint_residual_error = 1e-6;   ///< ~constraint_residual_error: [m/s]
-};
-
-/// Reads and validates every private parameter. Throws std::invalid_argument naming the first bad one.
-CartSimParameters load_parameters(const ros::NodeHandle& private_node);
 
 /// Something that prevents the node from starting (bad parameter, scene, integrator or bag).
 class NodeStartupError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
-
-/// Signal handling without roscpp's: SIGINT and SIGTERM request a clean shutdown (the node closes
-/// its bag before it exits). Call once after ros::init(..., NoSigintHandler).
-void install_shutdown_signal_handlers();
-/// True once SIGINT/SIGTERM arrived.
-bool shutdown_signal_received();
 
 class CartSimNode {
  public:

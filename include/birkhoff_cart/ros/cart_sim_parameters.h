@@ -1,0 +1,49 @@
+// Every private parameter of cart_sim, read and validated in one place (robot_localization's
+// loadParams habit). Each is documented in README.md, "ROS interface" (meaning, unit, default).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <ros/node_handle.h>
+
+#include "birkhoff_cart/ros/conversions.h"
+
+namespace birkhoff_cart {
+
+/// Every private parameter of cart_sim, with its default (README.md, "ROS interface").
+struct CartSimParameters {
+  std::string scene_path;                    ///< ~scene: scene YAML (required)
+  std::string integrator;                    ///< ~integrator: registry name; "" = the scene's
+  double step_size = 0.0;                    ///< ~step_size: h [s]; 0 = the scene's
+  double publish_rate = 100.0;               ///< ~publish_rate: [Hz of scene time]
+  bool fast = false;                         ///< ~fast: lockstep as fast as possible (true) or real time
+  double real_time_factor = 0.0;             ///< ~real_time_factor: [-]; 0 = unlimited (fast) / 1 (real time)
+  double duration = -1.0;                    ///< ~duration: [s]; < 0 = the scene's; 0 = until shutdown
+  double command_timeout = 0.5;              ///< ~command_timeout: watchdog silence [s of scene time]; 0 = off
+  double max_steering_torque = 100.0;        ///< ~max_steering_torque: clamp [N·m]
+  double max_drive_torque = 200.0;           ///< ~max_drive_torque: clamp [N·m]
+  std::string bag_path;                      ///< ~bag_path: record here; "" = no record
+  std::string bag_compression = "lz4";       ///< ~bag_compression: lz4, bz2 or none
+  std::uint64_t min_free_disk_space = 16u << 20;  ///< ~min_free_disk_space: refuse to record below [bytes]; 0 = no check
+  std::string summary_path;                  ///< ~summary_path: also write the final summary here; "" = no file
+  ros_conversions::FrameNames frames;        ///< ~odom_frame, ~base_frame
+  bool publish_tf = true;                    ///< ~publish_tf: odom → base_link on /tf
+  bool publish_clock = true;                 ///< ~publish_clock: the node drives /clock
+  bool start_paused = false;                 ///< ~start_paused: wait for ~pause(false) before stepping
+  double diagnostic_period = 1.0;            ///< ~diagnostic_period: /diagnostics every [s of scene time]
+  double energy_residual_warn = 1e-4;        ///< ~energy_residual_warn: |T* − T*₀ − W| [J]
+  double energy_residual_error = 1e-1;       ///< ~energy_residual_error: [J]
+  double p2_residual_warn = 1e-8;            ///< ~p2_residual_warn: |p2 − p2₀ − I2| [N·m·s]
+  double p2_residual_error = 1e-5;           ///< ~p2_residual_error: [N·m·s]
+  double constraint_residual_warn = 1e-9;    ///< ~constraint_residual_warn: max |(15)| [m/s]
+  double constraint_residual_error = 1e-6;   ///< ~constraint_residual_error: [m/s]
+};
+
+/// Reads and validates every private parameter. Throws std::invalid_argument naming the first bad one.
+CartSimParameters load_parameters(const ros::NodeHandle& private_node);
+
+/// `value` [s] with 10 significant digits, for log lines and service answers.
+std::string format_seconds(double value);
+
+}  // namespace birkhoff_cart

@@ -1,0 +1,126 @@
+// cart_sim's reports: /diagnostics and the final summary (see cart_sim_node.h).
+#include "birkhoff_cart/ros/cart_sim_node.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+namespace birkhoff_cart {
+
+void CartSimNode::produce_diagnostics(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  const Diagnostics diagnostics = simulation_->diagnostics();
+  const double wall_elapsed = (ros::WallTime::now() - run_start_wall_).toSec();
+  const double real_time_factor = wall_elapsed > 0.0 ? simulated_time_ / wall_elapsed : 0.0;
+
+  struct Check {
+    const char* name;
+    double value;
+    double warn;
+    double error;
+  };
+  const Check checks[] = {
+      {"energy-balance residual", std::abs(diagnostics.energy_balance_residual), parameters_.energy_residual_warn,
+       parameters_.energy_residual_error},
+      {"p2-balance residual", std::abs(diagnostics.p2_balance_residual), parameters_.p2_residual_warn,
+       parameters_.p2_residual_error},
+      {"constraint residual", diagnostics.max_constraint_residual, parameters_.constraint_residual_warn,
+       parameters_.constraint_residual_error},
+  };
+  unsigned char level = diagnostic_msgs::DiagnosticStatus::OK;
+  std::string message;
+  for (const Check& check : checks) {
+    unsigned char check_level = diagnostic_msgs::DiagnosticStatus::OK;
+    if (!(check.value < check.error)) {  // NaN counts as an error
+      check_level = diagnostic_msgs::DiagnosticStatus::ERROR;
+    } else if (check.value >= check.warn) {
+      check_level = diagnostic_msgs::DiagnosticStatus::WARN;
+    }
+    if (check_level != diagnostic_msgs::DiagnosticStatus::OK) {
+      message += std::string(message.empty() ? "" : "; ") + check.name +
+                 (check_level == diagnostic_msgs::DiagnosticStatus::ERROR ? " above error threshold"
+                                                                           : " above warning threshold");
+    }
+    level = std::max(level, check_level);
+  }
+  const std::uint64_t rejections = (steering_channel_ ? steering_channel_->rejected() : 0) +
+                                   (drive_channel_ ? drive_channel_->rejected() : 0);
+  if (rejections > diagnostics_rejections_seen_) {
+    level = std::max<unsigned char>(level, diagnostic_msgs::DiagnosticStatus::WARN);
+    message += std::string(message.empty() ? "" : "; ") + "non-finite commands rejected";
+    diagnostics_rejections_seen_ = rejections;
+  }
+  if (step_failure_) {
+    level = diagnostic_msgs::DiagnosticStatus::ERROR;
+    message = "step failed: " + *step_failure_;
+  }
+  status.summary(level, message.empty() ? "integration healthy" : message);
+  status.add("scene", simulation_->scene().name);
+  status.add("integrator", simulation_->integrator_name());
+  status.add("step size [s]", simulation_->step_size());
+  status.add("scene time [s]", simulation_->state().time);
+  status.add("steps taken", simulation_->statistics().steps);
+  status.add("paused", paused_);
+  status.add("real-time factor [-]", real_time_factor);
+  status.add("step cost [s]", last_wall_time_per_step_);
+  status.add("energy T* [J]", diagnostics.energy);
+  status.add("energy-balance residual [J]", diagnostics.energy_balance_residual);
+  status.add("p2-balance residual [N m s]", diagnostics.p2_balance_residual);
+  status.add("max constraint residual [m/s]", diagnostics.max_constraint_residual);
+  if (diagnostics.has_reference) {
+    status.add("reference position error [m]", diagnostics.reference_position_error);
+    status.add("reference heading error [rad]", diagnostics.reference_heading_error);
+    status.add("reference arc-length relative error [-]", diagnostics.reference_arc_length_relative_error);
+  }
+  const auto add_channel = [&status](const std::string& name, const std::optional<CommandChannel>& channel) {
+    status.add(name + " commands received", channel ? channel->received() : 0);
+    status.add(name + " commands rejected", channel ? channel->rejected() : 0);
+    status.add(name + " commands clamped", channel ? channel->clamped() : 0);
+    status.add(name + " command timeouts", channel ? channel->timeouts() : 0);
+  };
+  add_channel("steering_torque", steering_channel_);
+  add_channel("drive_torque", drive_channel_);
+}
+
+void CartSimNode::write_summary(const std::string& outcome) {
+  const CartState& state = simulation_->state();
+  const Diagnostics diagnostics = simulation_->diagnostics();
+  const Eigen::Vector2d rear_axle_midpoint = simulation_->model().rear_axle_midpoint(state);
+  const double wall_time = (ros::WallTime::now() - run_start_wall_).toSec();
+  std::ostringstream text;
+  text << std::setprecision(9);
+  text << "cart_sim summary: " << outcome << ". Scene '" << simulation_->scene().name << "', integrator "
+       << simulation_->integrator_name() << ", h = " << simulation_->step_size() << " s, final t = " << state.time
+       << " s. Final pose of base_link (rear-axle midpoint A): x = " << rear_axle_midpoint.x()
+       << " m, y = " << rear_axle_midpoint.y() << " m, theta = " << state.heading
+       << " rad. Energy T* = " << diagnostics.energy << " J, energy-balance residual = "
+       << diagnostics.energy_balance_residual << " J, p2-balance residual = " << diagnostics.p2_balance_residual
+       << " N m s, max constraint residual = " << diagnostics.max_constraint_residual << " m/s";
+  if (diagnostics.has_reference) {
+    text << ", reference position error = " << diagnostics.reference_position_error << " m";
+  }
+  text << ". Steps: " << total_steps_ << " (" << simulation_->statistics().newton_iterations_total
+       << " Newton iterations since the last start), wall time " << wall_time << " s (stepping "
+       << stepping_wall_time_ << " s), real-time factor " << (wall_time > 0.0 ? simulated_time_ / wall_time : 0.0)
+       << ". Published instants: " << published_instants_ << ".";
+  if (recorder_) {
+    text << " Bag: " << recorder_->current_path() << (record_failure_ ? " (unfinished; " : " (");
+    bool first = true;
+    for (const auto& [topic, count] : recorder_->message_counts()) {
+      text << (first ? "" : ", ") << topic << ": " << count;
+      first = false;
+    }
+    text << ").";
+  } else {
+    text << " No bag recorded.";
+  }
+  ROS_INFO("%s", text.str().c_str());
+  if (!parameters_.summary_path.empty()) {
+    std::ofstream file(parameters_.summary_path);
+    file << text.str() << "\n";
+    if (!file) ROS_ERROR("cart_sim: cannot write the summary to %s", parameters_.summary_path.c_str());
+  }
+}
+
+}  // namespace birkhoff_cart
