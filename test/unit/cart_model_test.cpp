@@ -5,6 +5,7 @@
 // T* (2.8) against the body-by-body kinetic energy of the independent full-coordinate model.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -114,14 +115,42 @@ TEST_F(CartModelIdentities, NaiveLagrangeEquationInSteeringAngleViolatesSteering
   EXPECT_GT(clearly_violated, 150);
 }
 
-// ω·Λ_nh = 0 (eq. (3.7)).
-TEST_F(CartModelIdentities, NonholonomicForceIsWorkless) {
+// ω·Λ_nh = 0 (eq. (3.7)), and Λ_nh is the force the rolling constraints exert: ṗ − ∂T*/∂q|_ω − Q
+// of the independent full-coordinate model (p from its body-by-body kinetic energy, ṗ by a central
+// difference along its motion). Workless alone would also hold for −Λ_nh or 0; the comparison
+// with the full model fixes the sign and the size.
+TEST_F(CartModelIdentities, NonholonomicForceIsWorklessAndIsTheRollingConstraintsForce) {
+  constexpr double kFullModelTolerance = 1e-6;  // relative to the largest momentum-rate term [-]
+  const full_model::FullCoordinateModel full(parameters_);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  double largest_force = 0.0;
   for (int trial = 0; trial < 500; ++trial) {
     const RandomReducedState state = draw();
     const Vector2<double> force = model_.nonholonomic_force(state.steering_angle, state.velocity);
     const double scale = state.velocity.squaredNorm() * (1.0 + state.velocity.norm()) * 200.0;
     EXPECT_NEAR(state.velocity.dot(force), 0.0, kRelativeTolerance * scale);
+    if (trial >= 50) continue;  // the full-model comparison costs ~10 KKT solves: 50 states suffice
+    Eigen::Matrix<double, 8, 1> q;
+    q << 3.0 * unit(generator_), 3.0 * unit(generator_), 3.0 * unit(generator_), state.steering_angle,
+        unit(generator_), unit(generator_), unit(generator_), unit(generator_);
+    const Eigen::Matrix<double, 8, 1> qd = full.admissible_velocity(q, state.velocity(0), state.velocity(1));
+    full_model::AppliedLoads loads;  // Q = (T cos χ / r1, τ) (docs eqs. (4.1)–(4.2))
+    loads.drive_torque = state.force(0) * parameters_.rear_wheel_radius;  // T [N·m]
+    loads.steering_torque = state.force(1);
+    const Vector2<double> applied(loads.drive_torque * std::cos(state.steering_angle) / parameters_.rear_wheel_radius,
+                                  loads.steering_torque);
+    const Eigen::Vector2d momentum_rate =
+        full.reduced_momentum_rate(q, qd, full_model::FullCoordinateModel::applied_force(loads));
+    const double steering_gradient =
+        full.reduced_energy_steering_derivative(q, state.velocity(0), state.velocity(1));  // ∂T*/∂χ|_ω
+    const Eigen::Vector2d full_force = momentum_rate - Eigen::Vector2d(0.0, steering_gradient) - applied;
+    const double term_scale = 1.0 + momentum_rate.cwiseAbs().maxCoeff() + std::abs(steering_gradient) +
+                              applied.cwiseAbs().maxCoeff();
+    EXPECT_NEAR(force(0), full_force(0), kFullModelTolerance * term_scale) << "trial " << trial;
+    EXPECT_NEAR(force(1), full_force(1), kFullModelTolerance * term_scale) << "trial " << trial;
+    largest_force = std::max(largest_force, force.cwiseAbs().maxCoeff() / term_scale);
   }
+  EXPECT_GT(largest_force, 0.1);  // the comparison saw Λ_nh of the size of the other terms
 }
 
 // ṗ = ∂T*/∂q|_ω + Λ_nh + Q (eq. (3.6)) describes the same motion as M ω̇ + h = Q (eq. (3.4)):

@@ -290,6 +290,38 @@ class FullCoordinateModel {
     return qd(kX) * std::cos(front) + qd(kY) * std::sin(front);
   }
 
+  /// The momenta conjugate to the two quasi-velocities, computed from the body-by-body kinetic
+  /// energy alone: q̇ = ω1 v1(q) + ω2 v2(q) on the constraint manifold, so
+  ///   p_i = ∂T*/∂ω_i = q̇ᵀ M(q) v_i(q),   v_i = admissible_velocity(q, e_i)   [kg·m/s, kg·m²/s].
+  /// (Any q̇, admissible or not, is projected this way; along the motion it is admissible.)
+  Eigen::Vector2d reduced_momentum(const Vector8& q, const Vector8& qd) const {
+    const Matrix8 mass = mass_matrix(q);
+    return {qd.dot(mass * admissible_velocity(q, 1.0, 0.0)), qd.dot(mass * admissible_velocity(q, 0.0, 1.0))};
+  }
+
+  /// ṗ along the full model's motion under the generalized force f [N, N·m in q]: central
+  /// difference of reduced_momentum over ±ε [s] with q(±ε), q̇(±ε) from their Taylor series
+  /// (error O(ε²); ε = 1e-5 s gives ~1e-9 relative).
+  Eigen::Vector2d reduced_momentum_rate(const Vector8& q, const Vector8& qd, const Vector8& force,
+                                        double epsilon = 1e-5) const {
+    const Vector8 qdd = acceleration(q, qd, force);
+    const Vector8 q_later = q + epsilon * qd + 0.5 * epsilon * epsilon * qdd;
+    const Vector8 q_earlier = q - epsilon * qd + 0.5 * epsilon * epsilon * qdd;
+    return (reduced_momentum(q_later, qd + epsilon * qdd) - reduced_momentum(q_earlier, qd - epsilon * qdd)) /
+           (2.0 * epsilon);
+  }
+
+  /// ∂T*/∂χ at constant ω, T*(χ, ω) = T(q, ω1 v1 + ω2 v2), by a central difference in χ [J/rad].
+  double reduced_energy_steering_derivative(const Vector8& q, double forward_speed, double steering_rate,
+                                            double epsilon = 1e-6) const {
+    Vector8 q_plus = q, q_minus = q;
+    q_plus(kSteering) += epsilon;
+    q_minus(kSteering) -= epsilon;
+    return (kinetic_energy(q_plus, admissible_velocity(q_plus, forward_speed, steering_rate)) -
+            kinetic_energy(q_minus, admissible_velocity(q_minus, forward_speed, steering_rate))) /
+           (2.0 * epsilon);
+  }
+
  private:
   static Coordinates<Dual> seeded(const Vector8& q, const Vector8& qd) {
     Coordinates<Dual> q_dual;
