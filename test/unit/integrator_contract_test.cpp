@@ -126,7 +126,10 @@ struct StepperNames {
 };
 TYPED_TEST_SUITE(IntegratorContract, AllSteppers, StepperNames);
 
-TYPED_TEST(IntegratorContract, RegistryKnowsItAndReportsOrderAndSymmetry) {
+// The registry makes it under its own name. Its order() and symmetric() flags are checked against
+// measured behaviour (observed order, reversibility) in registry_properties_test.cpp: compared here
+// with TypeParam::kOrder they would be compared with the very constants the adapter returns.
+TYPED_TEST(IntegratorContract, RegistryKnowsIt) {
   const std::vector<std::string> names = integrator_names();
   ASSERT_NE(std::find(names.begin(), names.end(), TypeParam::name()), names.end());
   const Scene scene = load("free_coast");
@@ -134,8 +137,6 @@ TYPED_TEST(IntegratorContract, RegistryKnowsItAndReportsOrderAndSymmetry) {
   const EffectSet effects;
   const std::unique_ptr<CartStepper> stepper = make_cart_stepper(settings_for(TypeParam::name()), model, effects);
   EXPECT_EQ(stepper->name(), TypeParam::name());
-  EXPECT_EQ(stepper->order(), TypeParam::kOrder);
-  EXPECT_EQ(stepper->symmetric(), TypeParam::kSymmetric);
 }
 
 TYPED_TEST(IntegratorContract, ObservedOrderOnDampedOscillator) {

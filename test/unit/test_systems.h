@@ -204,5 +204,81 @@ struct CubicChartOscillator {
   }
 };
 
+/// A Birkhoffian system whose Darboux chart is nonlinear in z AND depends on t (docs eq. (B.22)):
+///   z = (q, p), R = (e^{γt} P(p), 0) with P(p) = p + p³/3 ⇒ K = e^{γt} (1 + p²) K₀,
+///   B = e^{γt} (P²/2m + k q²/2), ∂R/∂t = γ e^{γt} (P, 0)
+///   ⇒ q̇ = P/m, Ṗ = (1 + p²) ṗ = −k q − γ P: a damped oscillator in (q, P).
+/// Chart w = (Q, W) = (q, e^{γt} P(p)), in which it is Hamiltonian with
+/// H_w = e^{−γt} W²/2m + e^{γt} k Q²/2. Neither the identity chart (midpoint in z) nor any method
+/// that is symplectic only for constant or only for z-independent K preserves K(z, t) here.
+struct CubicDampedOscillator {
+  static constexpr int kDimension = 2;
+  static constexpr int kPassiveDimension = 0;
+  template <class S>
+  using Vector = Eigen::Matrix<S, 2, 1>;
+  template <class S>
+  using Matrix = Eigen::Matrix<S, 2, 2>;
+
+  double mass = 1.5;       // m [kg]
+  double stiffness = 2.0;  // k [N/m]
+  double damping = 0.3;    // γ [1/s]
+
+  bool non_birkhoffian_force_enabled() const { return false; }
+
+  template <class S>
+  static S chart_momentum(const S& p) {
+    return p + p * p * p / 3.0;
+  }
+  template <class S>
+  S growth(const S& t) const {
+    using std::exp;
+    return exp(damping * t);
+  }
+  template <class S>
+  Vector<S> birkhoff_functions(const Vector<S>& z, const S& t) const {
+    return Vector<S>(growth(t) * chart_momentum(z(1)), S(0.0) * z(0));
+  }
+  template <class S>
+  S birkhoffian(const Vector<S>& z, const S& t) const {
+    const S big_p = chart_momentum(z(1));
+    return growth(t) * (big_p * big_p / (2.0 * mass) + stiffness * z(0) * z(0) / 2.0);
+  }
+  template <class S>
+  Matrix<S> structure_matrix(const Vector<S>& z, const S& t) const {
+    const S g = growth(t) * (1.0 + z(1) * z(1));
+    Matrix<S> k;
+    k << S(0.0) * g, -g, g, S(0.0) * g;
+    return k;
+  }
+  template <class S>
+  Vector<S> birkhoffian_gradient(const Vector<S>& z, const S& t) const {
+    return growth(t) * Vector<S>(stiffness * z(0), chart_momentum(z(1)) / mass * (1.0 + z(1) * z(1)));
+  }
+  template <class S>
+  Vector<S> birkhoff_functions_time_derivative(const Vector<S>& z, const S& t) const {
+    return Vector<S>(damping * growth(t) * chart_momentum(z(1)), S(0.0) * z(0));
+  }
+  template <class S>
+  Vector<S> non_birkhoffian_force(const Vector<S>& z, const S& /*t*/) const {
+    return Vector<S>(S(0.0) * z(0), S(0.0) * z(0));
+  }
+  template <class S>
+  Vector<S> to_darboux(const Vector<S>& z, const S& t) const {
+    return Vector<S>(z(0), growth(t) * chart_momentum(z(1)));
+  }
+  template <class S>
+  Vector<S> from_darboux(const Vector<S>& w, const S& t) const {
+    return Vector<S>(w(0), cubic_chart_inverse(S(w(1) / growth(t))));
+  }
+  template <class S>
+  Vector<S> darboux_rates(const Vector<S>& w, const S& t) const {
+    return Vector<S>(w(1) / (growth(t) * mass), -growth(t) * stiffness * w(0));
+  }
+  template <class S>
+  Eigen::Matrix<S, 0, 1> passive_rates(const Vector<S>& /*z*/, const S& /*t*/) const {
+    return Eigen::Matrix<S, 0, 1>();
+  }
+};
+
 }  // namespace testing
 }  // namespace birkhoff_cart

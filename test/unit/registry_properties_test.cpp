@@ -1,0 +1,173 @@
+// What each registered integrator's step map preserves for the real cart (Λ ≠ 0), measured
+// through the registry (make_cart_stepper) for every name in integrator_names() and both
+// Birkhoffian forms, so a new member is covered without touching this file:
+//  (its reported order() is checked against the order observed by step halving along the
+//  independent model's path in trajectory_vs_independent_model_test.cpp);
+//  - its reported symmetric() is what the free cart shows under the two reversing maps of the
+//    cart (Modin & Verdier 2020): R₁: p ↦ −p, and R₂: (π1, χ) ↦ (−π1, −π − χ) with p kept.
+//    A symmetric member's step map Φ_h is R-reversible, R Φ_h R Φ_h = id, to round-off in the
+//    autonomous form; a non-symmetric one misses by O(n h^{p+1});
+//  - in the paper's eᵗ form a member that steps in the chart w = (π1, χ, e^{t−tₑ} p) is not
+//    reversible (its momenta grow by 1 + O(h³) per step whatever the direction: see
+//    docs/birkhoffian.md §8); a member that never uses the chart makes the same steps in both forms.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "birkhoff_cart/core/cart_model.h"
+#include "birkhoff_cart/core/effect_library.h"
+#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/scene.h"
+
+namespace birkhoff_cart {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kRoundOff = 1e-12;             // reversal defect of a reversible map, relative [-]
+constexpr double kIrreversibleFactor = 1e3;     // a non-reversible map misses by ≥ this × kRoundOff [-]
+constexpr double kReversalStep = 0.1;           // h of the reversal runs [s]
+constexpr int kReversalSteps = 20;              // n: 2 s of free whirl each way
+constexpr double kFormIndependence = 1e-13;     // paper vs autonomous step of a chart-free member [-]
+
+Scene load(const std::string& name) {
+  return load_scene(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/" + name + ".yaml");
+}
+
+/// The registry's settings for `name` in `form`. The dopri5 tolerance is set so large that its
+/// controller accepts every full step: its map is then the fixed-step 5th-order Dormand–Prince map,
+/// whose irreversibility shows at h = 0.1 s (at 1e-10 it would be at its tolerance).
+IntegratorSettings settings_for(const std::string& name, const std::string& form) {
+  IntegratorSettings settings;
+  settings.name = name;
+  settings.birkhoffian_form = form;
+  settings.tolerance = 1e6;
+  return settings;
+}
+
+/// A registry member run over a scene: n steps of h from the scene's start.
+struct Runner {
+  Scene scene;
+  CartModel model;
+  EffectSet effects;
+  explicit Runner(const Scene& s) : scene(s), model(s.cart), effects(build_effects(s.effects, model)) {}
+
+  CartState run(const IntegratorSettings& settings, CartState state, double h, int steps) const {
+    const std::unique_ptr<CartStepper> stepper = make_cart_stepper(settings, model, effects);
+    StepStatistics statistics;
+    const double t0 = state.time;
+    for (int k = 1; k <= steps; ++k) {
+      stepper->step(state, h, statistics);
+      state.time = t0 + k * h;
+    }
+    return state;
+  }
+};
+
+/// (π1, χ, ω1, ω2, x, y, θ) [m, rad, m/s, rad/s, m, m, rad].
+Eigen::Matrix<double, 7, 1> observed(const CartState& s) {
+  Eigen::Matrix<double, 7, 1> o;
+  o << s.arc_length, s.steering_angle, s.forward_speed, s.steering_rate, s.x, s.y, s.heading;
+  return o;
+}
+
+/// R₁: p ↦ −p. p = M(χ) ω is linear in ω, so in the cart state ω ↦ −ω; positions are kept.
+CartState momentum_flip(CartState s) {
+  s.forward_speed = -s.forward_speed;
+  s.steering_rate = -s.steering_rate;
+  return s;
+}
+
+/// R₂: (π1, χ) ↦ (−π1, −π − χ), p kept: sin χ is kept and cos χ changes sign, so M(χ) and hence ω
+/// are kept and the nonholonomic force h = (μ1 s c ω1 ω2, ν c ω1 ω2) changes sign. The passive
+/// coordinates follow as (x, y, θ) ↦ (x, −y, −θ); the test compares only z and (x, y, θ).
+CartState steering_reflection(CartState s) {
+  s.arc_length = -s.arc_length;
+  s.steering_angle = -kPi - s.steering_angle;
+  s.y = -s.y;
+  s.heading = -s.heading;
+  return s;
+}
+
+using Reversal = CartState (*)(CartState);
+
+/// max |R Φⁿ R Φⁿ x − x| relative to max(1, |x|), on the free cart from a whirling start.
+double reversal_defect(const Runner& runner, const IntegratorSettings& settings, Reversal reverse) {
+  CartState start = runner.scene.initial_state;
+  start.steering_angle = 0.4;
+  start.forward_speed = 2.0;
+  start.steering_rate = -0.9;
+  start.arc_length = 0.3;
+  start.y = 0.2;
+  start.heading = 0.1;
+  CartState state = runner.run(settings, start, kReversalStep, kReversalSteps);
+  state = reverse(state);
+  state.time = start.time;  // the free cart is autonomous; the paper form's epoch is per step
+  state = runner.run(settings, state, kReversalStep, kReversalSteps);
+  state = reverse(state);
+  const Eigen::Matrix<double, 7, 1> x0 = observed(start);
+  return (observed(state) - x0).cwiseAbs().maxCoeff() / std::max(1.0, x0.cwiseAbs().maxCoeff());
+}
+
+std::vector<std::string> names() { return integrator_names(); }
+
+class RegistryMember : public testing::TestWithParam<std::string> {
+ protected:
+  std::unique_ptr<CartStepper> make(const std::string& form, const Runner& runner) const {
+    return make_cart_stepper(settings_for(GetParam(), form), runner.model, runner.effects);
+  }
+};
+
+TEST_P(RegistryMember, ReportedSymmetryIsReversibilityUnderBothMapsInTheAutonomousForm) {
+  const Runner runner(load("free_coast"));
+  const IntegratorSettings settings = settings_for(GetParam(), "autonomous");
+  const bool symmetric = make("autonomous", runner)->symmetric();
+  const double flip = reversal_defect(runner, settings, momentum_flip);
+  const double reflection = reversal_defect(runner, settings, steering_reflection);
+  std::printf("[ measured ] %s (autonomous, %s): reversal defect %.3e under p ↦ −p, %.3e under (π1, χ) ↦ (−π1, −π − χ)\n",
+              GetParam().c_str(), symmetric ? "symmetric" : "not symmetric", flip, reflection);
+  if (symmetric) {
+    EXPECT_LE(flip, kRoundOff);
+    EXPECT_LE(reflection, kRoundOff);
+  } else {
+    EXPECT_GE(flip, kIrreversibleFactor * kRoundOff);
+    EXPECT_GE(reflection, kIrreversibleFactor * kRoundOff);
+  }
+}
+
+TEST_P(RegistryMember, PaperFormIsReversibleOnlyWhereItMakesTheAutonomousSteps) {
+  const Runner runner(load("free_coast"));
+  const IntegratorSettings autonomous = settings_for(GetParam(), "autonomous");
+  const IntegratorSettings paper = settings_for(GetParam(), "paper");
+  CartState start = runner.scene.initial_state;
+  start.time = 3.0;
+  const CartState by_autonomous = runner.run(autonomous, start, kReversalStep, kReversalSteps);
+  const CartState by_paper = runner.run(paper, start, kReversalStep, kReversalSteps);
+  const double form_difference = (observed(by_paper) - observed(by_autonomous)).cwiseAbs().maxCoeff() /
+                                 std::max(1.0, observed(by_autonomous).cwiseAbs().maxCoeff());
+  const bool uses_chart = form_difference > kFormIndependence;
+  const double flip = reversal_defect(runner, paper, momentum_flip);
+  const double reflection = reversal_defect(runner, paper, steering_reflection);
+  std::printf("[ measured ] %s (paper): differs from its autonomous steps by %.3e; reversal defect %.3e (p ↦ −p), "
+              "%.3e (χ reflection)\n",
+              GetParam().c_str(), form_difference, flip, reflection);
+  if (!uses_chart) {
+    // The same steps as in the autonomous form: the same reversibility.
+    EXPECT_NEAR(flip, reversal_defect(runner, autonomous, momentum_flip), 1e-12);
+  } else {
+    // The chart's e^{t−tₑ} makes the step map irreversible whatever the method's symmetry.
+    EXPECT_GE(flip, kIrreversibleFactor * kRoundOff);
+    EXPECT_GE(reflection, kIrreversibleFactor * kRoundOff);
+    EXPECT_GE(form_difference, kIrreversibleFactor * kFormIndependence);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryMember, RegistryMember, testing::ValuesIn(names()),
+                         [](const testing::TestParamInfo<std::string>& info) { return info.param; });
+
+}  // namespace
+}  // namespace birkhoff_cart
