@@ -21,6 +21,7 @@
 #include <string>
 
 #include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/paper_form_drift.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
 
@@ -143,6 +144,8 @@ int main(int argc, char** argv) {
   bool ends_off_grid = false;  // the end time t0 + duration is not on the 1/HZ grid
   try {
     simulation = std::make_unique<Simulation>(scene);
+    const std::string drift = birkhoff_cart::paper_form_drift_warning(scene);  // the eᵗ form's h² drift
+    if (!drift.empty()) std::fprintf(stderr, "cart_simulate: %s\n", drift.c_str());
     steps_between_rows = steps_per_output(scene);
     const double intervals = scene.duration * scene.output_rate;
     output_intervals = static_cast<long>(std::floor(intervals * (1.0 + kCommensurabilityTolerance)));
