@@ -6,7 +6,8 @@
 //    and the recovered messages are a gap-free prefix of the run (the last, unfinished chunk is lost).
 //  - an unwritable ~bag_path: non-zero exit at once, stderr names the path.
 //  - determinism: two runs of the same scene with the same commands record bit-identical odom and
-//    joint_states messages and identical integration_error fields except wall_time_per_step.
+//    joint_states messages and identical integration_error fields except wall_time_per_step; both
+//    bags hold the commands sent (values and count), recorded before the first published instant.
 #include <gtest/gtest.h>
 
 #include <signal.h>
@@ -89,7 +90,12 @@ TEST(FaultSignals, SigtermClosesTheBagWithEveryMessageUpToShutdown) {
                                    scratch("sigterm.log"));
   ASSERT_GT(pid, 0);
   ASSERT_TRUE(birkhoff_cart_test::wait_for([&] { return file_exists(bag_path + ".active"); }, kWaitTimeout));
-  ros::WallDuration(1.5).sleep();  // ≈ 1.5 s of scene time in real-time mode
+  // 1.5 s of scene time, read from the node's own /odom stamps (not from the wall clock).
+  ros::NodeHandle node;
+  double odom_time = 0.0;  // [s of scene time]
+  ros::Subscriber odom_subscriber = node.subscribe<nav_msgs::Odometry>(
+      "/odom", 10, [&odom_time](const nav_msgs::Odometry::ConstPtr& message) { odom_time = message->header.stamp.toSec(); });
+  ASSERT_TRUE(birkhoff_cart_test::wait_for([&] { return odom_time >= 1.5; }, kWaitTimeout)) << "t = " << odom_time;
   ASSERT_EQ(::kill(pid, SIGTERM), 0);
   EXPECT_EQ(wait_exit(pid, 30.0), 0) << read_file(scratch("sigterm.log"));
   ASSERT_TRUE(file_exists(bag_path));
@@ -232,6 +238,18 @@ std::vector<birkhoff_cart::IntegrationError> integration_errors(const std::strin
   return errors;
 }
 
+/// The data of every std_msgs/Float64 on `topic`, in order.
+std::vector<double> command_values(const std::string& path, const std::string& topic) {
+  rosbag::Bag bag(path, rosbag::bagmode::Read);
+  rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{topic}));
+  std::vector<double> values;
+  for (const rosbag::MessageInstance& instance : view) {
+    const auto command = instance.instantiate<std_msgs::Float64>();
+    if (command) values.push_back(command->data);
+  }
+  return values;
+}
+
 template <class Message>
 std::vector<uint8_t> serialized(const Message& message) {
   const uint32_t length = ros::serialization::serializationLength(message);
@@ -263,9 +281,25 @@ TEST(FaultSignals, SameSceneAndCommandsRecordIdenticalData) {
     // compared as bytes: the reference-error fields are NaN without a reference, and NaN != NaN
     EXPECT_EQ(serialized(left), serialized(right)) << "integration_error " << k;
   }
-  // The commands were recorded as received, the same in both.
+  // The commands arrived, before the run started, and were recorded as received, the same in both:
+  // without them both runs would be the unforced scene and identical anyway.
+  for (const auto& [path, name] : {std::make_pair(first, std::string("determinism_a")),
+                                   std::make_pair(second, std::string("determinism_b"))}) {
+    const std::vector<double> steering = command_values(path, "/" + name + "/steering_torque");
+    const std::vector<double> drive = command_values(path, "/" + name + "/drive_torque");
+    EXPECT_EQ(steering, (std::vector<double>{0.4, 1.2, 0.8})) << name;
+    EXPECT_EQ(drive, (std::vector<double>{25.0})) << name;
+    const std::vector<double> first_odom = stamps(path, "/odom");
+    ASSERT_FALSE(first_odom.empty()) << name;
+    for (const char* topic : {"/steering_torque", "/drive_torque"}) {
+      for (double t : stamps(path, "/" + name + topic)) {
+        EXPECT_LT(t, first_odom.front()) << name << topic << " arrived after the run had started";
+      }
+    }
+  }
   EXPECT_EQ(raw_messages(first, "/determinism_a/steering_torque"),
             raw_messages(second, "/determinism_b/steering_torque"));
+  EXPECT_EQ(raw_messages(first, "/determinism_a/drive_torque"), raw_messages(second, "/determinism_b/drive_torque"));
   std::remove(first.c_str());
   std::remove(second.c_str());
 }
