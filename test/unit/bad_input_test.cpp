@@ -76,6 +76,9 @@ TEST(BadCommands, NonFiniteTorquesAreRefusedAndTheHeldCommandStays) {
 }
 
 TEST(BadCommands, AnAbsurdFiniteTorqueFailsTheStepAndLosesNothing) {
+  // Pinned outcome (measured for every member, new ones included by integrator_names()): a 1e300 N·m
+  // steering command makes the step fail with StepError, the state kept; a member that "survives"
+  // it has stepped into overflow unnoticed.
   for (const std::string& integrator : integrator_names()) {
     Scene scene = load_scene(scene_path("driven"));
     scene.integrator.name = integrator;
@@ -83,27 +86,19 @@ TEST(BadCommands, AnAbsurdFiniteTorqueFailsTheStepAndLosesNothing) {
     for (int k = 0; k < 50; ++k) simulation.step();
     const CartState before = simulation.state();
     simulation.set_steering_command(kAbsurdTorque);
-    bool failed = false;
     try {
       simulation.step();
+      ADD_FAILURE() << integrator << " stepped with a 1e300 N m steering command to omega2 = "
+                    << simulation.state().steering_rate;
     } catch (const StepError& error) {
-      failed = true;
       EXPECT_FALSE(std::string(error.what()).empty());
     }
-    if (failed) {
-      EXPECT_TRUE(same_state(before, simulation.state())) << integrator;
-    } else {  // a scheme that survives must still hold finite values
-      const CartState& state = simulation.state();
-      EXPECT_TRUE(std::isfinite(state.steering_rate) && std::isfinite(state.forward_speed)) << integrator;
-    }
-    std::printf("[ measured ] %s with a 1e300 N m steering command: %s\n", integrator.c_str(),
-                failed ? "StepError, state kept" : "stepped");
+    EXPECT_TRUE(same_state(before, simulation.state())) << integrator;
+    std::printf("[ measured ] %s with a 1e300 N m steering command: StepError, state kept\n", integrator.c_str());
     // A sane command afterwards: the simulation carries on from where it was.
     simulation.set_steering_command(0.5);
-    if (failed) {
-      EXPECT_NO_THROW(simulation.step()) << integrator;
-      EXPECT_GT(simulation.state().time, before.time);
-    }
+    EXPECT_NO_THROW(simulation.step()) << integrator;
+    EXPECT_GT(simulation.state().time, before.time);
   }
 }
 

@@ -415,6 +415,13 @@ Scene step_torque_scene() {
   return scene;
 }
 
+/// The measured outcome of the large-step runs, pinned: only birkhoff4 in the paper form at
+/// h = 0.2 s stops (Newton meets a singular Jacobian at t ≈ 2.27 s: its inner substep γ₂h = −0.34 s
+/// runs backwards through the step torque); every other member, new ones included, runs to the end.
+bool large_step_run_stops(const Method& method, double h) {
+  return method.integrator == "birkhoff4" && method.form == "paper" && h == 0.2;
+}
+
 TEST(LargeSteps, BoundedOrAClearErrorNeverGarbage) {
   Scene fine = step_torque_scene();
   fine.integrator.name = "dopri5";
@@ -430,6 +437,8 @@ TEST(LargeSteps, BoundedOrAClearErrorNeverGarbage) {
       const RunOutcome outcome = run(scene);
       const std::string label = method.integrator + "/" + method.form + " h = " + std::to_string(h);
       EXPECT_TRUE(outcome.every_state_finite) << label;
+      // Pinned outcome: every run reaches the end except those listed as stopping.
+      EXPECT_EQ(outcome.stopped, large_step_run_stops(method, h)) << label << ": " << outcome.error;
       if (outcome.stopped) {
         EXPECT_FALSE(outcome.error.empty()) << label;
         EXPECT_EQ(outcome.error.find('\n'), std::string::npos) << label;
@@ -455,7 +464,7 @@ struct ExtremeCart {
   double duration;     ///< [s]
 };
 
-TEST(ExtremeParameters, StableOrAClearError) {
+TEST(ExtremeParameters, EveryExtremeCartRunsWithItsInvariantsKept) {
   const std::vector<ExtremeCart> carts = {
       {"very light (x1e-3)", 1e-3, 1.05, 1e-3, 2.0}, {"very heavy (x1e3)", 1e3, 1.05, 1e-3, 2.0},
       {"tiny wheelbase 1 cm", 1.0, 0.01, 1e-5, 0.5}, {"feather x1e-6, 1 cm", 1e-6, 0.01, 1e-5, 0.5}};
@@ -474,22 +483,19 @@ TEST(ExtremeParameters, StableOrAClearError) {
       }
       p.wheelbase = cart.wheelbase;
       const std::string label = cart.label + " " + integrator;
+      // Pinned outcome (measured): every one of these carts runs to the end with its invariants
+      // kept; none is refused at construction and no step fails.
       try {
         const RunOutcome outcome = run(scene);
         EXPECT_TRUE(outcome.every_state_finite) << label;
-        if (outcome.stopped) {
-          EXPECT_FALSE(outcome.error.empty()) << label;
-          EXPECT_TRUE(outcome.state_kept_on_error) << label;
-        } else {
-          EXPECT_LT(outcome.max_energy_residual / outcome.initial_energy, kExtremeEnergyRelativeTolerance) << label;
-          EXPECT_LT(outcome.max_constraint_residual, kConstraintTolerance) << label;
-        }
+        EXPECT_FALSE(outcome.stopped) << label << ": " << outcome.error;
+        EXPECT_LT(outcome.max_energy_residual / outcome.initial_energy, kExtremeEnergyRelativeTolerance) << label;
+        EXPECT_LT(outcome.max_constraint_residual, kConstraintTolerance) << label;
         std::printf("[ measured ] extreme %s: %s, max |dT*|/T*0 = %.3g, chi in [%.3g, %.3g] rad\n", label.c_str(),
                     outcome.stopped ? outcome.error.c_str() : "ran", outcome.max_energy_residual / outcome.initial_energy,
                     outcome.min_steering_angle, outcome.max_steering_angle);
-      } catch (const std::invalid_argument& error) {  // refused at construction: must say why
-        EXPECT_GT(std::string(error.what()).size(), 10u) << label;
-        std::printf("[ measured ] extreme %s: refused: %s\n", label.c_str(), error.what());
+      } catch (const std::invalid_argument& error) {
+        ADD_FAILURE() << label << " refused at construction: " << error.what();
       }
     }
   }
