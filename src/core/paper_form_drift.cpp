@@ -47,7 +47,8 @@ std::string paper_form_drift_warning(const Scene& scene) {
   message << "warning: the paper's e^t form with " << scene.integrator.name << " at h = " << scene.integrator.step_size
           << " s multiplies the momenta by about 1 + " << paper_form_momentum_change_per_step(scene)
           << " per step regardless of the motion: over " << scene.duration << " s they drift by " << 100.0 * growth
-          << " % (energy about twice that); use birkhoffian_form: autonomous for long runs (docs/birkhoffian.md §8)";
+          << " % and the energy by at least twice that (10x on the jackknife whirl); use birkhoffian_form: "
+             "autonomous for long runs (docs/birkhoffian.md §9)";
   return message.str();
 }
 

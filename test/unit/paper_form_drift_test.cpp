@@ -1,4 +1,4 @@
-// The paper's eᵗ form drifts (docs/birkhoffian.md §8): a member stepping in the chart
+// The paper's eᵗ form drifts (docs/birkhoffian.md §9): a member stepping in the chart
 // w = (π1, χ, e^{t−tₑ} p) multiplies the momenta by 1 + δ per step whatever the motion, δ = h³/12 + …
 // for birkhoff2. The core measures δ (paper_form_drift.h); these tests check the measured δ
 // against the closed form, the predicted growth against a real run, and when the warning fires.
