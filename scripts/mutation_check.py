@@ -1,0 +1,233 @@
+#!/usr/bin/python3
+"""Mutation check: applies a fixed list of named source mutations, one at a time, to a scratch copy
+of the repository, builds only the test targets that should notice, runs those tests, and fails
+(exit status 1) if any mutation survives — i.e. if every one of its tests still passes.
+
+Usage: /usr/bin/python3 scripts/mutation_check.py [--scratch DIR] [--only NAME ...] [--list]
+
+The working tree is never modified: the tracked files are copied (git ls-files) to
+DIR/src/birkhoff_cart (default: $TMPDIR/birkhoff_cart_mutation), configured once with CMake
+(catkin, tests on) in DIR/build, and each mutation is applied to the scratch copy and undone before
+the next. An unmutated baseline of the same tests must pass first, otherwise the check is
+meaningless and it stops. A mutation whose target text is not found exactly once is an error (the
+code moved: update the list), not a kill. Repeated runs reuse the scratch build (ccache, make).
+"""
+import argparse
+import os
+import pathlib
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+REPO = pathlib.Path(__file__).resolve().parent.parent
+
+
+class Mutation:
+    def __init__(self, name, why, path, original, mutated, tests):
+        self.name = name          # short name printed in the report
+        self.why = why            # the defect it stands for
+        self.path = path          # file, relative to the repository
+        self.original = original  # text that must occur exactly once
+        self.mutated = mutated    # its replacement
+        self.tests = tests        # [(test target, gtest filter)]
+
+
+TRAJECTORY = "trajectory_vs_independent_model_test"
+
+MUTATIONS = [
+    Mutation(
+        "nonholonomic_force_sign",
+        "the nonholonomic force Λ_nh,1 in ṗ1 = Λ_nh,1 + Q1 enters with the wrong sign",
+        "include/birkhoff_cart/core/cart_model.h",
+        "rate(0) = nonholonomic_force_at(s, c, quasi_velocity)(0) + generalized_force(0);",
+        "rate(0) = -nonholonomic_force_at(s, c, quasi_velocity)(0) + generalized_force(0);",
+        [(TRAJECTORY, "*"), ("cart_birkhoffian_test", "*")],
+    ),
+    Mutation(
+        "birkhoff4_weights",
+        "birkhoff4 composes birkhoff2 with equal weights 1/3 (birkhoff2's order) instead of the triple jump",
+        "include/birkhoff_cart/core/integrators/birkhoff_symplectic.h",
+        "static double outer_weight() { return 1.0 / (2.0 - std::cbrt(2.0)); }",
+        "static double outer_weight() { return 1.0 / 3.0; }",
+        [(TRAJECTORY, "*birkhoff4*"), ("registry_properties_test", "*birkhoff4*")],
+    ),
+    Mutation(
+        "chart_time_at_step_end",
+        "birkhoff2 leaves the Darboux chart at tₖ instead of tₖ₊₁",
+        "include/birkhoff_cart/core/integrators/birkhoff_symplectic.h",
+        "z = system.from_darboux(w_next, S(t_next));",
+        "z = system.from_darboux(w_next, S(t_next - h));",  # = tₖ (t_next stays used: -Werror)
+        [(TRAJECTORY, "*paper*"), ("k_symplectic_test", "*")],
+    ),
+    Mutation(
+        "dropped_air_drag_force",
+        "an effect term is dropped: air drag adds its Jacobian but no force",
+        "src/core/effects/air_drag.cpp",
+        "total.force(0) += -k * std::abs(speed_a) * speed_a * c;",
+        "static_cast<void>(c);",
+        [(TRAJECTORY, "*birkhoff2*"), ("effects_test", "*"), ("independent_model_test", "*")],
+    ),
+    Mutation(
+        "odom_at_hinge",
+        "odometry reports the hinge B instead of base_link at the rear-axle midpoint A",
+        "src/ros/conversions.cpp",
+        "nav_msgs::Odometry to_odometry(const CartState& state, const CartModel& model, const FrameNames& frames) {\n"
+        "  const Eigen::Vector2d rear_axle_midpoint = model.rear_axle_midpoint(state);",
+        "nav_msgs::Odometry to_odometry(const CartState& state, const CartModel& model, const FrameNames& frames) {\n"
+        "  const Eigen::Vector2d rear_axle_midpoint(state.x, state.y + 0.0 * model.parameters().wheelbase);",
+        [("conversions_test", "*")],
+    ),
+    Mutation(
+        "nan_drive_torque_accepted",
+        "a NaN drive_torque command is accepted",
+        "src/core/simulation.cpp",
+        'require_finite_torque(torque, "drive");',
+        "",
+        [("bad_input_test", "*"), ("simulation_test", "*")],
+    ),
+    Mutation(
+        "passive_left_point",
+        "birkhoff2's passive coordinates use the left point (z⁽ᵏ⁾, tₖ) instead of the midpoint",
+        "include/birkhoff_cart/core/integrators/birkhoff_symplectic.h",
+        "y = passive_midpoint(system, z_mid, y, t_mid, h, statistics);",
+        "static_cast<void>(z_mid);\n    y = passive_midpoint(system, z, y, t, h, statistics);",
+        [(TRAJECTORY, "*birkhoff2*"), ("integrator_contract_test", "*birkhoff2*")],
+    ),
+]
+
+
+def run(command, cwd=None, log=None):
+    """Runs `command`; returns (exit status, combined output)."""
+    result = subprocess.run(command, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    if log is not None:
+        log.write(f"$ {' '.join(map(str, command))}\n{result.stdout}\n")
+        log.flush()
+    return result.returncode, result.stdout
+
+
+def copy_tracked_files(source_root: pathlib.Path):
+    status, listing = run(["git", "-C", str(REPO), "ls-files", "-z"])
+    if status != 0:
+        sys.exit(f"mutation_check: git ls-files failed in {REPO}")
+    source_root.mkdir(parents=True, exist_ok=True)
+    for name in listing.split("\0"):
+        if not name:
+            continue
+        source = REPO / name
+        target = source_root / name
+        if not source.is_file():
+            continue
+        if target.is_file() and target.read_bytes() == source.read_bytes():
+            continue  # unchanged: keep its time stamp so make rebuilds nothing
+        target.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(source, target)
+
+
+def find_binary(build: pathlib.Path, target: str) -> pathlib.Path:
+    for candidate in (build / "devel/lib/birkhoff_cart" / target, build / target):
+        if candidate.is_file():
+            return candidate
+    found = [p for p in build.rglob(target) if p.is_file() and os.access(p, os.X_OK)]
+    if not found:
+        raise FileNotFoundError(f"test binary {target} not found under {build}")
+    return found[0]
+
+
+def build_and_run(build: pathlib.Path, tests, log):
+    """Builds the targets of `tests` and runs each; returns (built, [failing tests], [passing tests])."""
+    targets = sorted({target for target, _ in tests})
+    status, output = run(["make", "-C", str(build), "-j2", *targets], log=log)
+    if status != 0:
+        return False, [], []
+    failing, passing = [], []
+    for target, gtest_filter in tests:
+        status, output = run([str(find_binary(build, target)), f"--gtest_filter={gtest_filter}"], log=log)
+        label = f"{target} --gtest_filter={gtest_filter}"
+        (failing if status != 0 else passing).append(label)
+    return True, failing, passing
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scratch", type=pathlib.Path,
+                        default=pathlib.Path(tempfile.gettempdir()) / "birkhoff_cart_mutation")
+    parser.add_argument("--only", nargs="*", help="names of the mutations to apply (default: all)")
+    parser.add_argument("--list", action="store_true", help="list the mutations and exit")
+    arguments = parser.parse_args()
+    if arguments.list:
+        for mutation in MUTATIONS:
+            print(f"{mutation.name}: {mutation.why} ({mutation.path})")
+        return 0
+    chosen = [m for m in MUTATIONS if not arguments.only or m.name in arguments.only]
+    unknown = set(arguments.only or []) - {m.name for m in MUTATIONS}
+    if unknown:
+        sys.exit(f"mutation_check: unknown mutation(s) {', '.join(sorted(unknown))}; --list shows them")
+
+    started = time.time()
+    scratch = arguments.scratch.resolve()
+    source = scratch / "src/birkhoff_cart"
+    build = scratch / "build"
+    scratch.mkdir(parents=True, exist_ok=True)
+    log = open(scratch / "mutation_check.log", "w")
+    print(f"mutation_check: scratch copy in {scratch} (log: {scratch / 'mutation_check.log'})", flush=True)
+    copy_tracked_files(source)
+
+    environment_path = "/usr/bin:/bin:" + os.environ.get("PATH", "")
+    os.environ["PATH"] = environment_path
+    os.environ.setdefault("CCACHE_BASEDIR", str(scratch))
+    if not (build / "Makefile").is_file():
+        build.mkdir(parents=True, exist_ok=True)
+        launcher = ["-DCMAKE_CXX_COMPILER_LAUNCHER=ccache"] if shutil.which("ccache") else []
+        status, output = run(["cmake", "-S", str(source), "-B", str(build), "-DCMAKE_BUILD_TYPE=Release",
+                              "-DCATKIN_ENABLE_TESTING=ON", "-DPYTHON_EXECUTABLE=/usr/bin/python3",
+                              "-DPython3_EXECUTABLE=/usr/bin/python3", *launcher], log=log)
+        if status != 0:
+            print(output[-3000:])
+            sys.exit("mutation_check: CMake configuration of the scratch copy failed")
+
+    # Baseline: the unmutated tests must pass, or a "kill" would mean nothing.
+    all_tests = sorted({test for mutation in chosen for test in mutation.tests})
+    built, failing, _ = build_and_run(build, all_tests, log)
+    if not built or failing:
+        print("mutation_check: the UNMUTATED baseline does not pass: " + (", ".join(failing) or "build failed"))
+        return 1
+    print(f"baseline: {len(all_tests)} test runs pass ({time.time() - started:.0f} s)", flush=True)
+
+    killed, survived, broken = [], [], []
+    for mutation in chosen:
+        path = source / mutation.path
+        pristine = (REPO / mutation.path).read_text()
+        occurrences = pristine.count(mutation.original)
+        if occurrences != 1:
+            broken.append(mutation.name)
+            print(f"ERROR    {mutation.name}: its target text occurs {occurrences} times in {mutation.path}")
+            continue
+        began = time.time()
+        try:
+            path.write_text(pristine.replace(mutation.original, mutation.mutated))
+            built, failing, passing = build_and_run(build, mutation.tests, log)
+        finally:
+            path.write_text(pristine)
+        seconds = time.time() - began
+        if not built:
+            broken.append(mutation.name)
+            print(f"ERROR    {mutation.name}: the mutated source does not build ({seconds:.0f} s; see the log)")
+        elif failing:
+            killed.append(mutation.name)
+            print(f"killed   {mutation.name} ({mutation.why}) by {'; '.join(failing)} ({seconds:.0f} s)", flush=True)
+        else:
+            survived.append(mutation.name)
+            print(f"SURVIVED {mutation.name} ({mutation.why}): {'; '.join(passing)} all pass ({seconds:.0f} s)",
+                  flush=True)
+    # Rebuild the pristine tests so the scratch build matches the source again.
+    build_and_run(build, all_tests, log)
+    total = len(chosen)
+    print(f"{len(killed)} of {total} mutations killed, {len(survived)} survived, {len(broken)} errors "
+          f"({time.time() - started:.0f} s)")
+    return 0 if len(killed) == total else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
