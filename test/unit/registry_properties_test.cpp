@@ -162,16 +162,21 @@ TEST_P(RegistryMember, PaperFormIsReversibleOnlyWhereItMakesTheAutonomousSteps) 
     // The same steps as in the autonomous form: the same reversibility.
     EXPECT_NEAR(flip, reversal_defect(runner, autonomous, momentum_flip), 1e-12);
   } else {
-    // The chart's e^{t−tₑ} makes the step map irreversible whatever the method's symmetry.
-    EXPECT_GE(flip, kIrreversibleFactor * kRoundOff);
-    EXPECT_GE(reflection, kIrreversibleFactor * kRoundOff);
-    EXPECT_GE(form_difference, kIrreversibleFactor * kFormIndependence);
+    // The chart's e^{t−tₑ} makes the step map irreversible whatever the method's symmetry, by as
+    // much as it departs from the (reversible) autonomous map: the departure grows the momenta in
+    // either direction, so out and back it doubles instead of cancelling (measured ratio ≈ 2).
+    EXPECT_GE(flip, 0.5 * form_difference);
+    EXPECT_GE(reflection, 0.5 * form_difference);
   }
 }
 
-/// max |p2 − p2₀ − ∫Q2 dt| over 200 steps of h = 0.05 s of a steering-torque and damping scene,
-/// relative to max(1, |∫Q2 dt|) [-].
-double p2_balance_defect(const std::string& name, const std::string& form) {
+/// A steering-torque and damping scene run for 200 steps of h = 0.05 s.
+struct SteeringMomentumRun {
+  double worst_defect = 0.0;  ///< max |p2 − p2₀ − ∫Q2 dt| / max(1, |∫Q2 dt|) [-]
+  std::vector<double> p2;     ///< p2 after each step [kg·m²/s]
+};
+
+SteeringMomentumRun steering_momentum_run(const std::string& name, const std::string& form) {
   Scene scene = load("sine_steer_torque");
   EffectSpec damping;
   damping.name = "steering_damping";
@@ -181,37 +186,34 @@ double p2_balance_defect(const std::string& name, const std::string& form) {
   scene.integrator.step_size = 0.05;
   scene.duration = 10.0;
   Simulation simulation(scene);
-  double worst = 0.0;
+  SteeringMomentumRun run;
   for (int k = 0; k < 200; ++k) {
     simulation.step();
     const double scale = std::max(1.0, std::abs(simulation.state().steering_impulse));
-    worst = std::max(worst, std::abs(simulation.diagnostics().p2_balance_residual) / scale);
+    run.worst_defect = std::max(run.worst_defect, std::abs(simulation.diagnostics().p2_balance_residual) / scale);
+    run.p2.push_back(simulation.model().steering_momentum(simulation.state()));
   }
-  return worst;
+  return run;
 }
 
 // ṗ2 = Q2 exactly (docs eq. (3.8)); I2 = ∫Q2 dt is a passive coordinate stepped with the same
 // stages, so p2 − I2 is a linear invariant of the stepped system: every Runge–Kutta-type member keeps
 // it to round-off in the autonomous form. In the paper form a member that steps in the chart
-// (e^{t−tₑ} p2) does not (pinned: its defect is far above round-off).
+// (e^{t−tₑ} p2) does not: its p2 departs from the autonomous run's and the balance shows it.
 TEST_P(RegistryMember, SteeringMomentumBalanceIsExactInTheAutonomousForm) {
-  const double autonomous = p2_balance_defect(GetParam(), "autonomous");
-  const double paper = p2_balance_defect(GetParam(), "paper");
-  const Runner runner(load("free_coast"));
-  CartState start = runner.scene.initial_state;
-  start.time = 3.0;
-  const double form_difference =
-      (observed(runner.run(settings_for(GetParam(), "paper"), start, kReversalStep, kReversalSteps)) -
-       observed(runner.run(settings_for(GetParam(), "autonomous"), start, kReversalStep, kReversalSteps)))
-          .cwiseAbs()
-          .maxCoeff();
-  std::printf("[ measured ] %s: p2 balance defect %.3e (autonomous), %.3e (paper)\n", GetParam().c_str(), autonomous,
-              paper);
-  EXPECT_LE(autonomous, kRoundOff);
-  if (form_difference > kFormIndependence * 10.0) {
-    EXPECT_GE(paper, kIrreversibleFactor * kRoundOff);
+  const SteeringMomentumRun autonomous = steering_momentum_run(GetParam(), "autonomous");
+  const SteeringMomentumRun paper = steering_momentum_run(GetParam(), "paper");
+  double departure = 0.0;  // max |p2(paper) − p2(autonomous)| / max(1, |p2|) [-]
+  for (std::size_t k = 0; k < paper.p2.size(); ++k) {
+    departure = std::max(departure, std::abs(paper.p2[k] - autonomous.p2[k]) / std::max(1.0, std::abs(autonomous.p2[k])));
+  }
+  std::printf("[ measured ] %s: p2 balance defect %.3e (autonomous), %.3e (paper); paper p2 departs by %.3e\n",
+              GetParam().c_str(), autonomous.worst_defect, paper.worst_defect, departure);
+  EXPECT_LE(autonomous.worst_defect, kRoundOff);
+  if (departure > kFormIndependence * 10.0) {
+    EXPECT_GE(paper.worst_defect, 0.02 * departure);  // measured ratios 0.73 (birkhoff2), 0.14 (birkhoff4)
   } else {
-    EXPECT_LE(paper, kRoundOff);
+    EXPECT_LE(paper.worst_defect, kRoundOff);
   }
 }
 
