@@ -120,6 +120,28 @@ TEST(CartSimulate, CommandLineOverridesTheScene) {
   std::remove(output.c_str());
 }
 
+// The paper's eᵗ form drifts like exp(t h²/12) (docs/birkhoffian.md §9): a run long enough for the
+// momenta to drift by more than 0.1 % is warned about on stderr, and still runs; a short one and
+// the autonomous form are not.
+TEST(CartSimulate, WarnsWhenAPaperFormRunIsLongEnoughToDrift) {
+  const std::string output = temp_path("drift.csv");
+  const std::string common = "--scene '" + scene_path("free_coast") + "' --integrator birkhoff2 --step 0.05 "
+                             "--output-rate 1 --output '" + output + "'";
+  const CliOutcome long_paper = run_cli(common + " --duration 200 --birkhoffian-form paper");
+  EXPECT_EQ(long_paper.exit_status, 0) << long_paper.standard_error;
+  EXPECT_NE(long_paper.standard_error.find("cart_simulate: warning: the paper's e^t form with birkhoff2"),
+            std::string::npos)
+      << long_paper.standard_error;
+  EXPECT_NE(long_paper.standard_error.find("autonomous"), std::string::npos) << long_paper.standard_error;
+  const CliOutcome short_paper = run_cli(common + " --duration 2 --birkhoffian-form paper");
+  EXPECT_EQ(short_paper.exit_status, 0);
+  EXPECT_EQ(short_paper.standard_error, "");
+  const CliOutcome long_autonomous = run_cli(common + " --duration 200 --birkhoffian-form autonomous");
+  EXPECT_EQ(long_autonomous.exit_status, 0);
+  EXPECT_EQ(long_autonomous.standard_error, "");
+  std::remove(output.c_str());
+}
+
 TEST(CartSimulate, BadArgumentsExitNonZeroWithUsage) {
   const std::string scene = "--scene '" + scene_path("free_coast") + "'";
   const std::string output = "--output '" + temp_path("never.csv") + "'";
