@@ -1,6 +1,7 @@
 // Numerical-error diagnostics as plain structs kept next to the state.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 
@@ -12,7 +13,37 @@ struct StepStatistics {
   std::uint64_t rhs_evaluations = 0;          ///< right-hand-side evaluations (incl. inside Newton)
   std::uint64_t newton_iterations_total = 0;  ///< 0 for explicit methods
   std::uint64_t newton_iterations_last_step = 0;
+
+  // The local error estimate (docs/accuracy.md): per step, the weighted max-norm
+  //   ê = maxᵢ |x̂ᵢ − xᵢ| / max(1, |xᵢ(tₖ)|)
+  // over the Birkhoffian variables z = (π1, χ, p1, p2) and the passive coordinates
+  // y = (x, y, θ, φ1..φ4, W, I2) in SI units (absolute below 1 unit, relative above), where x̂ − x is
+  // the method's own error estimate for the step (the difference to an embedded solution from the
+  // same stages, see each integrator's header). Methods without an estimate leave these NaN/0.
+  // Filled through record_local_error_estimate(), never written directly.
+  double local_error_estimate_last_step = std::numeric_limits<double>::quiet_NaN();  ///< ê of the last step [-]
+  double local_error_estimate_max = 0.0;  ///< largest ê since start/reset [-]
+  double local_error_estimate_sum = 0.0;  ///< Σ ê since start/reset: a global-error proxy without propagation [-]
+  std::uint64_t steps_with_error_estimate = 0;  ///< steps that recorded an estimate
 };
+
+/// Whether the method has recorded a local error estimate since start/reset.
+inline bool has_local_error_estimate(const StepStatistics& statistics) {
+  return statistics.steps_with_error_estimate > 0;
+}
+
+/// The one way an integrator reports its step's local error estimate ê [-] (see StepStatistics).
+/// Call once per successful step, inside step(), on the statistics it was given (the CartStepper
+/// adapter commits them only if the whole step succeeds). A non-finite ê is recorded as given: the
+/// accuracy guard treats it as an error.
+inline void record_local_error_estimate(StepStatistics& statistics, double estimate) {
+  statistics.local_error_estimate_last_step = estimate;
+  const double largest = statistics.local_error_estimate_max;
+  statistics.local_error_estimate_max = (std::isnan(estimate) || std::isnan(largest)) ? std::nan("")
+                                        : (estimate > largest ? estimate : largest);
+  statistics.local_error_estimate_sum += estimate;
+  ++statistics.steps_with_error_estimate;
+}
 
 /// Invariants and errors of one state (see msg/IntegrationError.msg for the published form).
 struct Diagnostics {

@@ -14,8 +14,14 @@
 // odeint stepper is made for every simulator step, so its first-same-as-last cache never holds a
 // rate from before a command change or a reset. Same inputs ⇒ bit-identical outputs.
 // Double precision only (odeint's controller is not meant to be differentiated).
+//
+// Error estimate (error_estimate.h): the pair's own x̂ − x (5th minus embedded 4th order) of each
+// accepted internal step, in the weighted norm ê of StepStatistics; a simulator step records the
+// sum over its internal steps (propagation ignored). It estimates the 4th-order solution's error
+// while the 5th-order one is propagated (local extrapolation), so it is an upper estimate.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <boost/numeric/odeint.hpp>
 #include <cmath>
@@ -29,6 +35,45 @@
 #include "birkhoff_cart/core/integrators/cart_stepper.h"
 
 namespace birkhoff_cart {
+
+namespace dopri5_detail {
+
+/// odeint's default error checker that first notes ê of the raw error vector x̂ − x (before the
+/// default checker overwrites it with the tolerance-scaled one) in *trial_estimate.
+template <class Value, class Algebra, class Operations>
+class NotingErrorChecker {
+ public:
+  using value_type = Value;
+  using algebra_type = Algebra;
+  using operations_type = Operations;
+  using Default = boost::numeric::odeint::default_error_checker<Value, Algebra, Operations>;
+
+  NotingErrorChecker(Value eps_abs, Value eps_rel, double* trial_estimate)
+      : default_(eps_abs, eps_rel), trial_estimate_(trial_estimate) {}
+
+  template <class State, class Deriv, class Err, class Time>
+  Value error(Algebra& algebra, const State& x_old, const Deriv& dxdt_old, Err& x_err, Time dt) const {
+    double estimate = 0.0;  // ê = maxᵢ |x̂ᵢ − xᵢ| / max(1, |xᵢ(tₖ)|)
+    for (std::size_t i = 0; i < x_err.size(); ++i) {
+      const double component = std::abs(x_err[i]) / std::max(1.0, std::abs(x_old[i]));
+      estimate = std::isnan(component) ? component : std::max(estimate, component);
+      if (std::isnan(estimate)) break;
+    }
+    *trial_estimate_ = estimate;
+    return default_.error(algebra, x_old, dxdt_old, x_err, dt);
+  }
+  template <class State, class Deriv, class Err, class Time>
+  Value error(const State& x_old, const Deriv& dxdt_old, Err& x_err, Time dt) const {
+    Algebra algebra;
+    return error(algebra, x_old, dxdt_old, x_err, dt);
+  }
+
+ private:
+  Default default_;
+  double* trial_estimate_;
+};
+
+}  // namespace dopri5_detail
 
 class DormandPrince5 {
  public:
@@ -81,13 +126,19 @@ class DormandPrince5 {
     double previous_time = t;
     double last_free_step = 0.0;
     const double end_time = t + h;
+    double trial_estimate = 0.0;  // ê of the latest trial internal step [-]
+    double step_estimate = 0.0;   // Σ ê over the accepted internal steps of [t, t + h] [-]
     auto observer = [&](const Joint&, double time) {
       const double taken = time - previous_time;
       if (time != t && time != end_time) last_free_step = taken;  // not shortened to hit t + h
+      if (time != t) step_estimate += trial_estimate;  // the observer sees accepted steps only
       previous_time = time;
     };
 
-    auto controlled = odeint::make_controlled(tolerance_, tolerance_, odeint::runge_kutta_dopri5<Joint>());
+    using Dopri5 = odeint::runge_kutta_dopri5<Joint>;
+    using Checker = dopri5_detail::NotingErrorChecker<double, typename Dopri5::algebra_type,
+                                                      typename Dopri5::operations_type>;
+    odeint::controlled_runge_kutta<Dopri5, Checker> controlled(Checker(tolerance_, tolerance_, &trial_estimate));
     // First internal step: the carried guess (a magnitude), with the sign of h (h < 0 runs backwards).
     const double first_guess = step_size_guess_ > 0.0 ? std::copysign(step_size_guess_, h) : h;
     try {
@@ -100,6 +151,7 @@ class DormandPrince5 {
       throw StepError(message.str());
     }
     statistics.rhs_evaluations += evaluations;
+    record_local_error_estimate(statistics, step_estimate);
 
     for (int i = 0; i < n; ++i) z(i) = x[i];
     for (int i = 0; i < m; ++i) y(i) = x[n + i];

@@ -14,6 +14,11 @@
 // the paper representation (a) and on the damped oscillator (K = e^{γt} K₀) the chart is not the
 // identity and the two differ: the midpoint rule in z preserves K₀-type quadratic structure only,
 // not K(z,t), so "midpoint" is symmetric but not K(z,t)-symplectic there.
+//
+// Error estimate (error_estimate.h): the explicit Euler predictor is the embedded 1st-order
+// solution, already computed, so ê = ‖z⁽ᵏ⁺¹⁾ − (z⁽ᵏ⁾ + h f(z⁽ᵏ⁾, tₖ))‖ = ‖h (f(z̄) − f(z⁽ᵏ⁾))‖ costs
+// nothing extra. It is O(h²) while the midpoint rule's local error is O(h³): an upper estimate.
+// It covers z only (the passive coordinates have no Euler predictor here).
 #pragma once
 
 #include <Eigen/Core>
@@ -21,6 +26,7 @@
 #include "birkhoff_cart/core/birkhoffian_system.h"
 #include "birkhoff_cart/core/diagnostics.h"
 #include "birkhoff_cart/core/integrators/birkhoff_symplectic.h"
+#include "birkhoff_cart/core/integrators/error_estimate.h"
 #include "birkhoff_cart/core/integrators/newton.h"
 
 namespace birkhoff_cart {
@@ -56,10 +62,14 @@ class ImplicitMidpoint {
     };
 
     // z⁽ᵏ⁺¹⁾ ← z⁽ᵏ⁾ + h f(z⁽ᵏ⁾, tₖ)   (explicit Euler predictor)
-    z = z_start + h * birkhoffian_rates(system, z_start, S(t));
+    const StateVector<System, S> z_euler = z_start + h * birkhoffian_rates(system, z_start, S(t));
     ++statistics.rhs_evaluations;
+    z = z_euler;
     // z⁽ᵏ⁺¹⁾ ← root of F by Newton
     solve_newton<n>(make_residual, z, newton_, t, statistics);
+    // ê ← ‖z⁽ᵏ⁺¹⁾ − z_Euler‖ (z only; the passive part of the error vector is left at 0)
+    record_local_error_estimate(statistics, local_error_norm<System, S>(z_start, y, StateVector<System, S>(z - z_euler),
+                                                                        PassiveVector<System, S>::Zero()));
     // z̄ ← (z⁽ᵏ⁾ + z⁽ᵏ⁺¹⁾)/2;  y⁽ᵏ⁺¹⁾ ← y⁽ᵏ⁾ + h g(z̄, ȳ, tₖ + h/2)
     const StateVector<System, S> z_mid = S(0.5) * (z_start + z);
     y = BirkhoffSymplectic2::passive_midpoint(system, z_mid, y, mid_time, h, statistics);

@@ -1,0 +1,46 @@
+// The weighted norm every integrator uses for its local error estimate ê (diagnostics.h,
+// StepStatistics; docs/accuracy.md §1). An integrator that has an error vector e = x̂ − x for a
+// step (the difference between its solution and an embedded one, a defect, ...) reports it as
+//
+//   record_local_error_estimate(statistics, local_error_norm(z_start, y_start, z_error, y_error));
+//
+// once per step. The weights make ê dimensionless: absolute for components below 1 SI unit,
+// relative above (odeint's error norm with ε_abs = ε_rel = 1, without its h·|ẋ| term):
+//
+//   ê = max( maxᵢ |e_zᵢ| / max(1, |zᵢ(tₖ)|),  maxⱼ |e_yⱼ| / max(1, |yⱼ(tₖ)|) ).
+//
+// Generic in the scalar S (double or an AD jet): only the values are used.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+#include "birkhoff_cart/core/autodiff.h"
+#include "birkhoff_cart/core/birkhoffian_system.h"
+
+namespace birkhoff_cart {
+
+/// max_i |error_i| / max(1, |start_i|) over one vector (Eigen column of double or AD jets) [-].
+template <class StartVector, class ErrorVector>
+double weighted_max_norm(const StartVector& start, const ErrorVector& error) {
+  double norm = 0.0;
+  for (int i = 0; i < start.size(); ++i) {
+    const double weight = 1.0 / std::max(1.0, std::abs(value_of(start(i))));
+    const double component = std::abs(value_of(error(i))) * weight;
+    if (std::isnan(component)) return component;
+    norm = std::max(norm, component);
+  }
+  return norm;
+}
+
+/// ê for a step from (z_start, y_start) with error vectors (z_error, y_error) [-].
+template <class System, class S>
+double local_error_norm(const StateVector<System, S>& z_start, const PassiveVector<System, S>& y_start,
+                        const StateVector<System, S>& z_error, const PassiveVector<System, S>& y_error) {
+  const double z_norm = weighted_max_norm(z_start, z_error);
+  const double y_norm = weighted_max_norm(y_start, y_error);
+  if (std::isnan(z_norm) || std::isnan(y_norm)) return std::nan("");
+  return std::max(z_norm, y_norm);
+}
+
+}  // namespace birkhoff_cart
