@@ -1,13 +1,18 @@
 // cart_simulate: runs a scene in batch and writes the trajectory as CSV (no ROS master needed).
 //
 //   cart_simulate --scene FILE [--integrator NAME] [--step H] [--tolerance TOL] [--duration T]
-//                 [--output-rate HZ] [--birkhoffian-form F] --output FILE.csv
+//                 [--output-rate HZ] [--birkhoffian-form F] [--on-accuracy-error fail|warn]
+//                 --output FILE.csv
 //
-// Columns: t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2 (SI units; energy is T*
-// [J], p2 the front axle's yaw momentum [kg·m²/s]); one row per output instant t0 + k/HZ from the
-// start to the end, both included; values printed with %.17g (round-trip exact).
+// Columns: t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,local_error_estimate (SI
+// units; energy is T* [J], p2 the front axle's yaw momentum [kg·m²/s], local_error_estimate the
+// last step's ê [-], empty when the integrator has none: docs/accuracy.md); one row per output
+// instant t0 + k/HZ from the start to the end, both included; values printed with %.17g
+// (round-trip exact). At the end a summary goes to stdout, with the accuracy guard's verdict
+// (the scene's `accuracy` limits, checked at every row).
 // Exit status: 0 done; 2 bad arguments (usage on stderr); 3 unusable scene or settings;
-// 4 a step failed (the rows written so far are kept).
+// 4 a step failed (the rows written so far are kept); 5 the accuracy guard reached ERROR (all rows
+// written; with --on-accuracy-error warn the run exits 0 and the summary still says ERROR).
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -20,8 +25,10 @@
 #include <stdexcept>
 #include <string>
 
+#include "birkhoff_cart/core/accuracy_guard.h"
 #include "birkhoff_cart/core/integrators/cart_stepper.h"
 #include "birkhoff_cart/core/paper_form_drift.h"
+#include "birkhoff_cart/core/run_summary.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
 
@@ -34,11 +41,13 @@ using birkhoff_cart::Simulation;
 constexpr int kExitUsage = 2;
 constexpr int kExitSettings = 3;
 constexpr int kExitStepFailed = 4;
+constexpr int kExitAccuracy = 5;
 constexpr double kCommensurabilityTolerance = 1e-9;  // relative, for "1/HZ is a multiple of h" [-]
 
 const char* const kUsage =
     "usage: cart_simulate --scene FILE [--integrator NAME] [--step H] [--tolerance TOL]\n"
-    "                     [--duration T] [--output-rate HZ] [--birkhoffian-form F] --output FILE.csv\n"
+    "                     [--duration T] [--output-rate HZ] [--birkhoffian-form F]\n"
+    "                     [--on-accuracy-error fail|warn] --output FILE.csv\n"
     "  --scene FILE            scene YAML (config/scenes/*.yaml); it provides every default\n"
     "  --integrator NAME       birkhoff2, birkhoff4, rk2, rk4, dopri5 or midpoint\n"
     "  --step H                step size [s], > 0; 1/HZ must be a whole multiple of it\n"
@@ -46,7 +55,10 @@ const char* const kUsage =
     "  --duration T            simulated time after the start [s], > 0\n"
     "  --output-rate HZ        output rows per simulated second [Hz], > 0\n"
     "  --birkhoffian-form F    autonomous or paper\n"
-    "  --output FILE.csv       where to write t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2\n"
+    "  --on-accuracy-error A   fail (default: exit 5 when the scene's accuracy guard reaches ERROR)\n"
+    "                          or warn (exit 0; the summary still names the quantity)\n"
+    "  --output FILE.csv       where to write t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,\n"
+    "                          local_error_estimate\n"
     "The rows are at t0 + k/HZ from the start to the end, both included; when the duration is not a\n"
     "whole number of output intervals, a last row is written at the end time t0 + T itself (reached\n"
     "by one shorter final step).\n";
@@ -67,7 +79,8 @@ double parse_positive(const std::string& option, const std::string& text) {
 
 std::map<std::string, std::string> parse_arguments(int argc, char** argv) {
   static const char* const kOptions[] = {"--scene",       "--integrator",       "--step",  "--tolerance",
-                                         "--duration",    "--output-rate",      "--birkhoffian-form", "--output"};
+                                         "--duration",    "--output-rate",      "--birkhoffian-form", "--output",
+                                         "--on-accuracy-error"};
   std::map<std::string, std::string> values;
   for (int i = 1; i < argc; ++i) {
     const std::string option = argv[i];
@@ -97,6 +110,9 @@ void apply_overrides(const std::map<std::string, std::string>& arguments, Scene&
       }
       scene.integrator.birkhoffian_form = text;
     }
+    if (option == "--on-accuracy-error" && text != "fail" && text != "warn") {
+      throw UsageError("option --on-accuracy-error must be 'fail' or 'warn', got '" + text + "'");
+    }
   }
 }
 
@@ -114,11 +130,21 @@ long steps_per_output(const Scene& scene) {
   return steps;
 }
 
-void write_row(std::FILE* file, double time, const CartState& state, double energy, double steering_momentum) {
-  std::fprintf(file, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", time,
+/// One CSV row at `time`, and the accuracy guard's check of the state there.
+void write_row(std::FILE* file, double time, const Simulation& simulation, birkhoff_cart::AccuracyGuard& guard) {
+  const CartState& state = simulation.state();
+  const birkhoff_cart::CartModel& model = simulation.model();
+  std::fprintf(file, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,", time,
                state.x, state.y, state.heading, state.steering_angle, state.wheel_spin_angle[0],
                state.wheel_spin_angle[1], state.wheel_spin_angle[2], state.wheel_spin_angle[3], state.arc_length,
-               state.forward_speed, state.steering_rate, energy, steering_momentum);
+               state.forward_speed, state.steering_rate, model.energy(state), model.steering_momentum(state));
+  const birkhoff_cart::StepStatistics& statistics = simulation.statistics();
+  const double estimate = statistics.local_error_estimate_last_step;  // ê [-]; none before the first step
+  if (birkhoff_cart::has_local_error_estimate(statistics) && std::isfinite(estimate)) {
+    std::fprintf(file, "%.17g", estimate);
+  }
+  std::fprintf(file, "\n");
+  guard.check(time, simulation.diagnostics(), statistics);
 }
 
 }  // namespace
@@ -162,18 +188,16 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "cart_simulate: cannot write '%s': %s\n", output_path.c_str(), std::strerror(errno));
     return kExitSettings;
   }
-  std::fprintf(file, "t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2\n");
+  std::fprintf(file, "t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,local_error_estimate\n");
   const double start_time = scene.initial_state.time;  // t0 [s]
-  const birkhoff_cart::CartModel& model = simulation->model();
+  birkhoff_cart::AccuracyGuard guard(scene.accuracy);
   long rows = 0;
   try {
     for (long k = 0; k <= output_intervals; ++k) {
       if (k > 0) {
         for (long n = 0; n < steps_between_rows; ++n) simulation->step();
       }
-      const CartState& state = simulation->state();
-      write_row(file, start_time + static_cast<double>(k) / scene.output_rate, state, model.energy(state),
-                model.steering_momentum(state));
+      write_row(file, start_time + static_cast<double>(k) / scene.output_rate, *simulation, guard);
       ++rows;
     }
     if (ends_off_grid) {
@@ -185,8 +209,7 @@ int main(int argc, char** argv) {
       if (end_time - simulation->state().time > kCommensurabilityTolerance * std::max(1.0, std::abs(end_time))) {
         simulation->step_to(end_time);
       }
-      const CartState& state = simulation->state();
-      write_row(file, end_time, state, model.energy(state), model.steering_momentum(state));
+      write_row(file, end_time, *simulation, guard);
       ++rows;
     }
   } catch (const birkhoff_cart::StepError& error) {
@@ -194,11 +217,19 @@ int main(int argc, char** argv) {
     std::fclose(file);
     std::fprintf(stderr, "cart_simulate: step failed after t = %.17g s (%ld rows written to %s): %s\n",
                  simulation->state().time, rows, output_path.c_str(), error.what());
+    std::printf("cart_simulate %s", birkhoff_cart::run_summary(*simulation, guard).c_str());
     return kExitStepFailed;
   }
   if (std::fclose(file) != 0) {
     std::fprintf(stderr, "cart_simulate: error writing '%s': %s\n", output_path.c_str(), std::strerror(errno));
     return kExitSettings;
+  }
+  std::printf("cart_simulate %s", birkhoff_cart::run_summary(*simulation, guard).c_str());
+  if (guard.level() == birkhoff_cart::AccuracyLevel::kError) {
+    const bool warn_only = arguments.count("--on-accuracy-error") && arguments.at("--on-accuracy-error") == "warn";
+    std::fprintf(stderr, "cart_simulate: accuracy %s%s\n", guard.summary().c_str(),
+                 warn_only ? " (--on-accuracy-error warn: exit 0)" : "");
+    if (!warn_only) return kExitAccuracy;
   }
   return 0;
 }

@@ -135,7 +135,7 @@ Scene read_scene(const SceneReader& reader, const YAML::Node& root, const std::s
   if (!root || root.IsNull()) reader.fail("(document)", "is empty");
   reader.require_map(root, "",
                      {"description", "cart", "paper_special_case", "initial_state", "duration", "integrator",
-                      "output_rate", "effects", "reference"});
+                      "output_rate", "effects", "reference", "accuracy"});
   Scene scene;
   scene.name = file_stem(path);
   scene.source_path = path;
@@ -154,6 +154,7 @@ Scene read_scene(const SceneReader& reader, const YAML::Node& root, const std::s
   scene.output_rate = reader.optional_number(root, "", "output_rate", Range::kPositive, scene.output_rate);
   scene.effects = scene_detail::read_effects(reader, root["effects"]);
   scene.reference = read_reference(reader, root["reference"], scene.paper_special_case);
+  scene.accuracy = scene_detail::read_accuracy(reader, root["accuracy"]);
 
   // The cart must give a usable mass matrix (only the declared paper case may be singular).
   if (scene.paper_special_case && scene.cart.wheelbase != 1.0) {

@@ -61,5 +61,8 @@ std::string join_names(const std::vector<std::string>& names);
 /// Reads the `effects` map (enabled effects only, in file order).
 std::vector<EffectSpec> read_effects(const SceneReader& reader, const YAML::Node& effects);
 
+/// Reads the optional `accuracy` map over the defaults of AccuracyRequirements.
+AccuracyRequirements read_accuracy(const SceneReader& reader, const YAML::Node& accuracy);
+
 }  // namespace scene_detail
 }  // namespace birkhoff_cart

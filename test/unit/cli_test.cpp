@@ -20,7 +20,7 @@
 namespace birkhoff_cart {
 namespace {
 
-const char* const kHeader = "t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2";
+const char* const kHeader = "t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,local_error_estimate";
 
 using birkhoff_cart_test::CliOutcome;
 using birkhoff_cart_test::read_file;
@@ -49,8 +49,8 @@ std::vector<double> parse_row(const std::string& line) {
   return values;
 }
 
-/// The row the CLI must write for `state` at output instant `time`.
-std::vector<double> expected_row(double time, const Simulation& simulation) {
+/// The state columns t … p2 the CLI must write at output instant `time`.
+std::vector<double> state_columns(double time, const Simulation& simulation) {
   const CartState& s = simulation.state();
   return {time,
           s.x,
@@ -66,6 +66,16 @@ std::vector<double> expected_row(double time, const Simulation& simulation) {
           s.steering_rate,
           simulation.model().energy(s),
           simulation.model().steering_momentum(s)};
+}
+
+/// The row the CLI must write for `state` at output instant `time` (the last field, the local
+/// error estimate, is empty before the first step and for integrators without one: no value).
+std::vector<double> expected_row(double time, const Simulation& simulation) {
+  std::vector<double> row = state_columns(time, simulation);
+  if (has_local_error_estimate(simulation.statistics())) {
+    row.push_back(simulation.statistics().local_error_estimate_last_step);
+  }
+  return row;
 }
 
 /// Runs the scene in-process and compares every CSV row with it, bit for bit.

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "birkhoff_cart/core/accuracy_guard.h"
 #include "birkhoff_cart/core/parameters.h"
 #include "birkhoff_cart/core/state.h"
 
@@ -88,6 +89,7 @@ struct Scene {
   double output_rate = 100.0;          ///< CSV / publish rate [Hz]
   std::vector<EffectSpec> effects;     ///< only the enabled ones
   ReferenceSettings reference;
+  AccuracyRequirements accuracy;       ///< the `accuracy` section (defaults: docs/accuracy.md §2)
 };
 
 /// Loads and validates a scene. Throws SceneError naming the file and the key.

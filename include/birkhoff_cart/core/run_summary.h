@@ -1,0 +1,18 @@
+// The end-of-run summary the batch CLI prints (and the node can log): work done, the balance
+// residuals, the local error estimate and the accuracy guard's verdict (docs/accuracy.md).
+#pragma once
+
+#include <string>
+
+#include "birkhoff_cart/core/accuracy_guard.h"
+#include "birkhoff_cart/core/simulation.h"
+
+namespace birkhoff_cart {
+
+/// "local error estimate: last 1.2e-09, max 3.4e-09, sum 5.6e-06 [-]" or "... none (<integrator> has none)".
+std::string local_error_estimate_summary(const StepStatistics& statistics, const std::string& integrator);
+
+/// Several lines, each ending in '\n', each starting with two spaces except the first.
+std::string run_summary(const Simulation& simulation, const AccuracyGuard& guard);
+
+}  // namespace birkhoff_cart

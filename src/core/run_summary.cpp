@@ -1,0 +1,39 @@
+#include "birkhoff_cart/core/run_summary.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace birkhoff_cart {
+
+std::string local_error_estimate_summary(const StepStatistics& statistics, const std::string& integrator) {
+  if (!has_local_error_estimate(statistics)) return "local error estimate: none (" + integrator + " has none)";
+  char text[160];
+  std::snprintf(text, sizeof text, "local error estimate: last %.3g, max %.3g, sum %.3g [-]",
+                statistics.local_error_estimate_last_step, statistics.local_error_estimate_max,
+                statistics.local_error_estimate_sum);
+  return text;
+}
+
+std::string run_summary(const Simulation& simulation, const AccuracyGuard& guard) {
+  const StepStatistics& statistics = simulation.statistics();
+  const Diagnostics diagnostics = simulation.diagnostics();
+  char line[512];
+  std::string text;
+  std::snprintf(line, sizeof line,
+                "summary: scene '%s', integrator %s, h = %g s, t = %.9g s, %llu steps, %llu rhs evaluations\n",
+                simulation.scene().name.c_str(), simulation.integrator_name().c_str(), simulation.step_size(),
+                simulation.state().time, static_cast<unsigned long long>(statistics.steps),
+                static_cast<unsigned long long>(statistics.rhs_evaluations));
+  text += line;
+  std::snprintf(line, sizeof line,
+                "  energy balance residual %.3g J (%.3g of the largest T*), p2 balance residual %.3g kg·m²/s, "
+                "max constraint residual %.3g m/s\n",
+                diagnostics.energy_balance_residual, guard.current_value(AccuracyQuantity::kEnergyBalanceRelative),
+                diagnostics.p2_balance_residual, diagnostics.max_constraint_residual);
+  text += line;
+  text += "  " + local_error_estimate_summary(statistics, simulation.integrator_name()) + "\n";
+  text += "  accuracy: " + guard.summary() + "\n";
+  return text;
+}
+
+}  // namespace birkhoff_cart
