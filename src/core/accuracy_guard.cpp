@@ -116,7 +116,10 @@ AccuracyLevel AccuracyGuard::check(double time, const Diagnostics& diagnostics, 
     const int i = index_of(quantity);
     current_level_ = std::max(current_level_, level);
     if (level <= reached_[i]) return;
-    // a first jump straight to ERROR also records when WARN was passed (same check)
+    // A jump straight from OK to ERROR passed WARN at the same check: record both, in order.
+    if (level == AccuracyLevel::kError && reached_[i] == AccuracyLevel::kOk && quantity != AccuracyQuantity::kNonFinite) {
+      events_.push_back({quantity, AccuracyLevel::kWarn, time, current_[i], requirements_.limit(quantity).warn});
+    }
     reached_[i] = level;
     events_.push_back({quantity, level, time, current_[i], limit});
   };
