@@ -80,6 +80,10 @@ class DormandPrince5 {
   static constexpr int kOrder = 5;
   static constexpr bool kSymmetric = false;
   static const char* name() { return "dopri5"; }
+  /// Most accepted internal steps over one simulator step [t, t + h]. Near a singularity (the
+  /// paper's case at χ → kπ) the controller's steps shrink without end and the run would hang;
+  /// past this count the step fails with a StepError instead (found by the randomized hard cases).
+  static constexpr long kMaxInternalSteps = 100000;
 
   /// `tolerance`: absolute and relative error tolerance per internal step [-], > 0.
   explicit DormandPrince5(double tolerance = 1e-10) : tolerance_(tolerance) {
@@ -128,7 +132,10 @@ class DormandPrince5 {
     const double end_time = t + h;
     double trial_estimate = 0.0;  // ê of the latest trial internal step [-]
     double step_estimate = 0.0;   // Σ ê over the accepted internal steps of [t, t + h] [-]
+    long internal_steps = 0;
+    struct TooManySteps {};
     auto observer = [&](const Joint&, double time) {
+      if (time != t && ++internal_steps > kMaxInternalSteps) throw TooManySteps{};
       const double taken = time - previous_time;
       if (time != t && time != end_time) last_free_step = taken;  // not shortened to hit t + h
       if (time != t) step_estimate += trial_estimate;  // the observer sees accepted steps only
@@ -144,6 +151,14 @@ class DormandPrince5 {
     try {
       // x(t + h) ← adaptive dopri5 steps over [t, t + h]
       odeint::integrate_adaptive(controlled, rates, x, t, end_time, first_guess, observer);
+    } catch (const TooManySteps&) {
+      statistics.rhs_evaluations += evaluations;
+      std::ostringstream message;
+      message.precision(17);
+      message << "dopri5 needed more than " << kMaxInternalSteps << " internal steps from t = " << t
+              << " s to " << end_time << " s (stalled at t = " << previous_time << " s; tolerance " << tolerance_
+              << "): the solution is singular or too stiff there";
+      throw StepError(message.str());
     } catch (const std::overflow_error& error) {  // odeint: too many rejected steps
       statistics.rhs_evaluations += evaluations;
       std::ostringstream message;

@@ -1,0 +1,231 @@
+// Randomized hard cases (issue 12 item 4, docs/accuracy.md §3): ≥ 1000 random valid carts and
+// scenes — masses, inertias and geometry over physical ranges (log-uniform), initial steering
+// angles on, through and near χ = kπ, steering/drive torques and drag on or off, a few of the
+// paper's singular special case — each run with every integrator in integrator_names() (so new
+// members are covered the day they are registered). Every run must end in one of three loud ways:
+//   finished  — every state at the output instants finite (what the CSV and ~integration_error
+//               would carry: the state, its diagnostics, the local error estimate when there is
+//               one), and the accuracy guard's verdict (OK / WARN / ERROR naming the quantity);
+//   StepError — its message names the time ("t = ") and a cause, and the state it left is the
+//               last good one (finite);
+// and nothing else (no other exception, no NaN or Inf anywhere). The counts are printed.
+// A fixed seed: the same 1000 cases on every run.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "birkhoff_cart/core/accuracy_guard.h"
+#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/simulation.h"
+
+namespace birkhoff_cart {
+namespace {
+
+constexpr int kSceneCount = 1000;
+constexpr std::uint64_t kSeed = 20261123;
+constexpr int kStepsBetweenChecks = 10;  // the guard and the finiteness checks, as at output instants
+
+class RandomScenes {
+ public:
+  explicit RandomScenes(std::uint64_t seed) : engine_(seed) {}
+
+  double uniform(double low, double high) { return std::uniform_real_distribution<double>(low, high)(engine_); }
+  double log_uniform(double low, double high) { return std::exp(uniform(std::log(low), std::log(high))); }
+  bool chance(double probability) { return uniform(0.0, 1.0) < probability; }
+  int integer(int low, int high) { return std::uniform_int_distribution<int>(low, high)(engine_); }
+
+  /// A physically plausible cart: sizes 5 cm … 5 m, masses 0.05 … 2000 kg, inertias m·L²·k with a
+  /// shape factor k, wheel inertias m r² · k.
+  CartParameters cart() {
+    CartParameters cart;
+    cart.wheelbase = log_uniform(0.02, 5.0);
+    cart.rear_half_track = log_uniform(0.05, 2.0);
+    cart.front_half_track = log_uniform(0.05, 2.0);
+    cart.rear_wheel_radius = log_uniform(0.02, 1.0);
+    cart.front_wheel_radius = log_uniform(0.02, 1.0);
+    cart.rear_body_mass = log_uniform(0.1, 2000.0);
+    cart.rear_body_yaw_inertia = cart.rear_body_mass * std::pow(cart.wheelbase, 2) * log_uniform(0.01, 1.0);
+    cart.front_axle_mass = log_uniform(0.05, 200.0);
+    cart.front_axle_yaw_inertia = cart.front_axle_mass * std::pow(cart.front_half_track, 2) * log_uniform(0.02, 0.5);
+    cart.rear_wheel_mass = log_uniform(0.05, 100.0);
+    cart.rear_wheel_spin_inertia = cart.rear_wheel_mass * std::pow(cart.rear_wheel_radius, 2) * uniform(0.3, 1.0);
+    cart.rear_wheel_yaw_inertia = cart.rear_wheel_mass * std::pow(cart.rear_wheel_radius, 2) * uniform(0.15, 0.6);
+    cart.front_wheel_mass = log_uniform(0.05, 100.0);
+    cart.front_wheel_spin_inertia = cart.front_wheel_mass * std::pow(cart.front_wheel_radius, 2) * uniform(0.3, 1.0);
+    cart.front_wheel_yaw_inertia = cart.front_wheel_mass * std::pow(cart.front_wheel_radius, 2) * uniform(0.15, 0.6);
+    return cart;
+  }
+
+  /// χ on kπ, within 10⁻¹² … 10⁻¹ rad of it, or anywhere; ω2 often aimed through kπ.
+  void steering(CartState& state) {
+    const double k = integer(-2, 2);
+    const double kind = uniform(0.0, 1.0);
+    const double offset = kind < 0.15 ? 0.0 : kind < 0.7 ? (chance(0.5) ? 1 : -1) * log_uniform(1e-12, 1e-1)
+                                                         : uniform(-M_PI, M_PI);
+    state.steering_angle = k * M_PI + offset;
+    const double rate = log_uniform(0.01, 4.0);
+    state.steering_rate = (offset > 0.0 && chance(0.7)) ? -rate : (chance(0.5) ? rate : -rate);
+  }
+
+  TorqueProfile torque(double amplitude) {
+    TorqueProfile profile;
+    if (chance(0.5)) {
+      profile.kind = TorqueProfile::Kind::kConstant;
+      profile.value = uniform(-amplitude, amplitude);
+    } else {
+      profile.kind = TorqueProfile::Kind::kCosine;
+      profile.amplitude = uniform(0.0, amplitude);
+      profile.frequency = log_uniform(0.05, 5.0);
+      profile.phase = uniform(0.0, 2.0 * M_PI);
+    }
+    return profile;
+  }
+
+  Scene scene(const Scene& base, int index) {
+    Scene scene = base;
+    scene.name = "random_" + std::to_string(index);
+    scene.reference = ReferenceSettings{};
+    scene.paper_special_case = chance(0.05);
+    scene.cart = cart();
+    if (scene.paper_special_case) scene.cart.wheelbase = 1.0;
+    CartState state;
+    state.time = chance(0.2) ? uniform(0.0, 100.0) : 0.0;
+    steering(state);
+    state.forward_speed = (chance(0.8) ? 1 : -1) * log_uniform(0.01, 20.0);
+    state.heading = uniform(-M_PI, M_PI);
+    scene.initial_state = state;
+    scene.duration = uniform(0.2, 1.0);
+    scene.integrator.step_size = chance(0.5) ? 1e-3 : chance(0.5) ? 5e-3 : 1e-2;
+    scene.integrator.tolerance = 1e-8;
+    scene.effects.clear();
+    const double body_mass = scene.cart.rear_body_mass + scene.cart.front_axle_mass;
+    if (chance(0.4)) scene.effects.push_back({"steering_torque", torque(0.5 * scene.cart.front_axle_yaw_inertia * 10.0), {}});
+    if (chance(0.4)) scene.effects.push_back({"drive_torque", torque(0.5 * body_mass * scene.cart.rear_wheel_radius), {}});
+    if (chance(0.3)) scene.effects.push_back({"air_drag", {}, {{"coefficient", log_uniform(0.01, 2.0)}}});
+    if (chance(0.3)) {
+      scene.effects.push_back({"rolling_resistance", {}, {{"coefficient", log_uniform(0.001, 0.05)},
+                                                          {"speed_epsilon", log_uniform(0.01, 0.2)}}});
+    }
+    if (chance(0.2)) scene.effects.push_back({"steering_damping", {}, {{"coefficient", log_uniform(0.01, 5.0)}}});
+    return scene;
+  }
+
+ private:
+  std::mt19937_64 engine_;
+};
+
+bool finite_state(const CartState& s) {
+  bool finite = std::isfinite(s.time) && std::isfinite(s.x) && std::isfinite(s.y) && std::isfinite(s.heading) &&
+                std::isfinite(s.steering_angle) && std::isfinite(s.arc_length) && std::isfinite(s.forward_speed) &&
+                std::isfinite(s.steering_rate) && std::isfinite(s.applied_work) && std::isfinite(s.steering_impulse);
+  for (double spin : s.wheel_spin_angle) finite = finite && std::isfinite(spin);
+  return finite;
+}
+
+/// What the CSV row and ~integration_error would carry at an output instant: all finite.
+bool finite_outputs(const Simulation& simulation) {
+  const Diagnostics d = simulation.diagnostics();
+  const StepStatistics& statistics = simulation.statistics();
+  return finite_state(simulation.state()) && std::isfinite(simulation.model().energy(simulation.state())) &&
+         std::isfinite(simulation.model().steering_momentum(simulation.state())) && std::isfinite(d.energy) &&
+         std::isfinite(d.energy_balance_residual) && std::isfinite(d.p2_balance_residual) &&
+         std::isfinite(d.max_constraint_residual) &&
+         (!has_local_error_estimate(statistics) || std::isfinite(statistics.local_error_estimate_last_step));
+}
+
+/// A StepError's cause in a few words, for the printed counts.
+std::string cause_of(const std::string& message) {
+  for (const char* cause : {"Newton", "non-finite", "internal steps", "det M", "singular", "failed"}) {
+    if (message.find(cause) != std::string::npos) return cause;
+  }
+  return "other";
+}
+
+struct Tally {
+  int ok = 0, warn = 0, guard_error = 0, step_error = 0;
+};
+
+TEST(RandomHardCases, EveryIntegratorEndsFiniteWithAVerdictOrStopsWithANamedStepError) {
+  Scene base = load_scene(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/free_coast.yaml");
+  RandomScenes random(kSeed);
+  std::map<std::string, Tally> tallies;
+  std::map<std::string, int> guard_quantities;
+  std::map<std::string, int> step_error_causes;
+  int scenes = 0, rejected = 0;
+  std::string first_step_error;
+  while (scenes < kSceneCount) {
+    const Scene scene = random.scene(base, scenes + rejected);
+    try {
+      Simulation probe(scene);  // a valid scene: the cart's mass matrix is usable
+    } catch (const std::invalid_argument&) {
+      ++rejected;
+      continue;
+    }
+    ++scenes;
+    for (const std::string& integrator : integrator_names()) {
+      Scene run = scene;
+      run.integrator.name = integrator;
+      Simulation simulation(run);
+      AccuracyGuard guard(run.accuracy);
+      guard.check(simulation.state().time, simulation.diagnostics(), simulation.statistics());
+      Tally& tally = tallies[integrator];
+      const std::string label = run.name + " with " + integrator;
+      bool failed = false;
+      long steps = 0;
+      try {
+        while (simulation.state().time + 0.5 * run.integrator.step_size < simulation.end_time()) {
+          simulation.step();
+          if (++steps % kStepsBetweenChecks == 0) {
+            ASSERT_TRUE(finite_outputs(simulation)) << label << " at t = " << simulation.state().time;
+            guard.check(simulation.state().time, simulation.diagnostics(), simulation.statistics());
+          }
+        }
+      } catch (const StepError& error) {
+        failed = true;
+        ++tally.step_error;
+        const std::string message = error.what();
+        EXPECT_NE(message.find("t = "), std::string::npos) << label << ": " << message;
+        EXPECT_GT(message.size(), 40u) << label << ": a cause must be named: " << message;
+        ASSERT_TRUE(finite_state(simulation.state())) << label << ": a failed step must leave the last good state";
+        ++step_error_causes[cause_of(message)];
+        if (first_step_error.empty()) first_step_error = label + ": " + message;
+      }
+      if (failed) continue;
+      ASSERT_TRUE(finite_outputs(simulation)) << label << " at the end";
+      guard.check(simulation.state().time, simulation.diagnostics(), simulation.statistics());
+      switch (guard.level()) {
+        case AccuracyLevel::kOk: ++tally.ok; break;
+        case AccuracyLevel::kWarn: ++tally.warn; break;
+        case AccuracyLevel::kError: {
+          ++tally.guard_error;
+          const AccuracyEvent* event = guard.first_worst_event();
+          ASSERT_NE(event, nullptr) << label;
+          ++guard_quantities[to_string(event->quantity)];
+          EXPECT_NE(guard.summary().find(to_string(event->quantity)), std::string::npos) << guard.summary();
+          break;
+        }
+      }
+    }
+  }
+  std::printf("%d random scenes (%d draws rejected as invalid carts), %zu integrators:\n", scenes, rejected,
+              integrator_names().size());
+  std::printf("  %-10s %6s %6s %12s %10s\n", "integrator", "OK", "WARN", "guard ERROR", "StepError");
+  for (const auto& [integrator, tally] : tallies) {
+    std::printf("  %-10s %6d %6d %12d %10d\n", integrator.c_str(), tally.ok, tally.warn, tally.guard_error,
+                tally.step_error);
+    EXPECT_EQ(tally.ok + tally.warn + tally.guard_error + tally.step_error, scenes) << integrator;
+  }
+  for (const auto& [quantity, count] : guard_quantities) std::printf("  guard ERROR on %s: %d\n", quantity.c_str(), count);
+  for (const auto& [cause, count] : step_error_causes) std::printf("  StepError %s: %d\n", cause.c_str(), count);
+  if (!first_step_error.empty()) std::printf("  e.g. %s\n", first_step_error.c_str());
+}
+
+}  // namespace
+}  // namespace birkhoff_cart
