@@ -229,3 +229,41 @@ TEST(RandomHardCases, EveryIntegratorEndsFiniteWithAVerdictOrStopsWithANamedStep
 
 }  // namespace
 }  // namespace birkhoff_cart
+
+namespace birkhoff_cart {
+namespace {
+
+// Found by the run above (random_149): the paper's singular cart 2.9 nrad below χ = −2π, turning
+// away from it, braked by a constant drive torque. dopri5's controller shrank its steps to
+// ~1e-15 s and spent minutes in the first step (7·10⁸ rhs evaluations before it was stopped); it
+// must fail with a StepError instead.
+TEST(RandomHardCases, Dopri5NextToThePaperCasePoleStopsWithAStepErrorInsteadOfHanging) {
+  Scene scene = load_scene(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/paper_special.yaml");
+  scene.reference = ReferenceSettings{};
+  scene.initial_state = CartState{};
+  scene.initial_state.steering_angle = -6.2831853082123983;  // −2π − 2.9e-9 [rad]
+  scene.initial_state.steering_rate = -0.017151594592757714;  // [rad/s]
+  scene.initial_state.forward_speed = 0.88054661294116721;    // [m/s]
+  scene.initial_state.heading = 1.5848449599933963;           // [rad]
+  EffectSpec brake{"drive_torque", {}, {}};
+  brake.profile.kind = TorqueProfile::Kind::kConstant;
+  brake.profile.value = -5.5524778703738518;  // [N·m]
+  scene.effects = {brake};
+  scene.integrator.name = "dopri5";
+  scene.integrator.step_size = 0.005;
+  scene.integrator.tolerance = 1e-8;
+  Simulation simulation(scene);
+  try {
+    simulation.step();
+    ADD_FAILURE() << "the step next to the pole succeeded";
+  } catch (const StepError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("internal steps"), std::string::npos) << message;
+    EXPECT_NE(message.find("t = 0 s"), std::string::npos) << message;
+  }
+  EXPECT_LE(simulation.statistics().rhs_evaluations, 0u);  // a failed step commits no work
+  EXPECT_EQ(simulation.state().time, 0.0);
+}
+
+}  // namespace
+}  // namespace birkhoff_cart
