@@ -24,9 +24,12 @@ const std::vector<std::string>& known_integrators() {
   return kNames;
 }
 
+/// `text` with every control character (line breaks, tabs, form feeds, ...) made a space: a
+/// SceneError's message is one line even when a key or value from the file holds such bytes.
 std::string one_line(std::string text) {
   for (char& character : text) {
-    if (character == '\n' || character == '\r') character = ' ';
+    const unsigned char code = static_cast<unsigned char>(character);
+    if (code < 0x20 || code == 0x7f) character = ' ';
   }
   return text;
 }
@@ -176,7 +179,7 @@ Scene read_scene(const SceneReader& reader, const YAML::Node& root, const std::s
 }  // namespace
 
 SceneError::SceneError(const std::string& file, const std::string& key, const std::string& problem)
-    : std::runtime_error("scene " + file + ": key '" + key + "': " + one_line(problem)), file_(file), key_(key) {}
+    : std::runtime_error(one_line("scene " + file + ": key '" + key + "': " + problem)), file_(file), key_(key) {}
 
 Scene load_scene(const std::string& path) {
   const SceneReader reader(path);
