@@ -21,10 +21,16 @@ std::string format_number(double value) {
   return text;
 }
 
+/// " kg·m²/s" after a value, nothing for a dimensionless quantity.
+std::string unit_suffix(AccuracyQuantity quantity) {
+  const std::string unit = unit_of(quantity);
+  return unit == "-" ? "" : " " + unit;
+}
+
 std::string describe(const AccuracyEvent& event) {
   std::string line = to_string(event.quantity);
   if (event.quantity == AccuracyQuantity::kNonFinite) return line + " diagnostic at t = " + format_number(event.time) + " s";
-  line += " " + format_number(event.value) + " > " + format_number(event.limit) + " " + unit_of(event.quantity) +
+  line += " " + format_number(event.value) + " > " + format_number(event.limit) + unit_suffix(event.quantity) +
           " (first at t = " + format_number(event.time) + " s)";
   return line;
 }
@@ -172,7 +178,7 @@ std::string AccuracyGuard::current_summary() const {
     const double value = current_[index_of(quantity)];
     if (!limit.enabled || !(value > limit.warn)) continue;
     line += std::string(first ? " " : "; ") + to_string(quantity) + " " + format_number(value) + " > " +
-            format_number(value > limit.error ? limit.error : limit.warn) + " " + unit_of(quantity);
+            format_number(value > limit.error ? limit.error : limit.warn) + unit_suffix(quantity);
     first = false;
   }
   if (current_[index_of(AccuracyQuantity::kNonFinite)] != 0.0) line += std::string(first ? " " : "; ") + "non_finite diagnostic";
