@@ -139,6 +139,10 @@ IntegrationError to_integration_error(const CartState& state, const Diagnostics&
   message.newton_iterations_last_step = statistics.newton_iterations_last_step;
   message.newton_iterations_total = statistics.newton_iterations_total;
   message.wall_time_per_step = wall_time_per_step;
+  message.has_local_error_estimate = has_local_error_estimate(statistics);
+  message.local_error_estimate = statistics.local_error_estimate_last_step;  // NaN without an estimate
+  message.local_error_estimate_max = statistics.local_error_estimate_max;
+  message.local_error_estimate_sum = statistics.local_error_estimate_sum;
   return message;
 }
 

@@ -119,5 +119,22 @@ TEST(Conversions, ActuatorEffortsFollowCommandsAndProfiles) {
   EXPECT_EQ(profiled.drive_torque, 0.0) << "no drive effect in that scene";
 }
 
+TEST(Conversions, IntegrationErrorCarriesTheLocalErrorEstimateOrSaysThereIsNone) {
+  const CartState state = moving_state();
+  const Diagnostics diagnostics;
+  StepStatistics statistics;
+  const IntegrationError none = ros_conversions::to_integration_error(state, diagnostics, statistics, "birkhoff2", 1e-3, 0.0);
+  EXPECT_FALSE(none.has_local_error_estimate);
+  EXPECT_TRUE(std::isnan(none.local_error_estimate));
+  EXPECT_EQ(none.local_error_estimate_sum, 0.0);
+  record_local_error_estimate(statistics, 3e-9);
+  record_local_error_estimate(statistics, 1e-9);
+  const IntegrationError some = ros_conversions::to_integration_error(state, diagnostics, statistics, "rk4", 1e-3, 0.0);
+  EXPECT_TRUE(some.has_local_error_estimate);
+  EXPECT_EQ(some.local_error_estimate, 1e-9);
+  EXPECT_EQ(some.local_error_estimate_max, 3e-9);
+  EXPECT_DOUBLE_EQ(some.local_error_estimate_sum, 4e-9);
+}
+
 }  // namespace
 }  // namespace birkhoff_cart
