@@ -8,6 +8,7 @@
 #include <rosgraph_msgs/Clock.h>
 
 #include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/ros/accuracy_reporting.h"
 #include "birkhoff_cart/ros/instant_schedule.h"
 
 namespace birkhoff_cart {
@@ -31,6 +32,11 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
     simulation_ = std::make_unique<Simulation>(scene);
   } catch (const std::exception& error) {
     throw NodeStartupError("cannot build the simulation of " + parameters_.scene_path + ": " + error.what());
+  }
+  try {
+    accuracy_guard_ = AccuracyGuard(ros_accuracy::load_requirements(private_node_, scene.accuracy));
+  } catch (const std::exception& error) {
+    throw NodeStartupError(std::string("bad parameter: ") + error.what());
   }
 
   const double start_time = simulation_->state().time;

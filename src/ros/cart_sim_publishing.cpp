@@ -3,6 +3,7 @@
 
 #include <rosgraph_msgs/Clock.h>
 
+#include "birkhoff_cart/ros/accuracy_reporting.h"
 #include "birkhoff_cart/ros/instant_schedule.h"
 
 namespace birkhoff_cart {
@@ -23,9 +24,12 @@ void CartSimNode::publish_instant() {
   last_wall_time_per_step_ = period_steps_ > 0 ? period_stepping_wall_time_ / static_cast<double>(period_steps_) : 0.0;
   period_stepping_wall_time_ = 0.0;
   period_steps_ = 0;
-  const IntegrationError error = ros_conversions::to_integration_error(
-      state, simulation_->diagnostics(), simulation_->statistics(), simulation_->integrator_name(),
-      simulation_->step_size(), last_wall_time_per_step_);
+  const Diagnostics diagnostics = simulation_->diagnostics();
+  accuracy_guard_.check(state.time, diagnostics, simulation_->statistics());
+  IntegrationError error = ros_conversions::to_integration_error(
+      state, diagnostics, simulation_->statistics(), simulation_->integrator_name(), simulation_->step_size(),
+      last_wall_time_per_step_);
+  ros_accuracy::fill(error, accuracy_guard_);
 
   odometry_publisher_.publish(odometry);
   joint_state_publisher_.publish(joints);

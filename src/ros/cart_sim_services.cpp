@@ -47,6 +47,7 @@ void CartSimNode::on_drive_torque(const std_msgs::Float64::ConstPtr& message) {
 
 bool CartSimNode::on_reset(std_srvs::Empty::Request& /*request*/, std_srvs::Empty::Response& /*response*/) {
   simulation_->reset();
+  accuracy_guard_.reset();
   const double start_time = simulation_->state().time;
   if (steering_channel_) {
     steering_channel_->restart(start_time);

@@ -1,5 +1,6 @@
 // cart_sim's reports: /diagnostics and the final summary (see cart_sim_node.h).
 #include "birkhoff_cart/ros/cart_sim_node.h"
+#include "birkhoff_cart/ros/accuracy_reporting.h"
 
 #include <algorithm>
 #include <cmath>
@@ -56,6 +57,7 @@ void CartSimNode::produce_diagnostics(diagnostic_updater::DiagnosticStatusWrappe
     message = "step failed: " + *step_failure_;
   }
   status.summary(level, message.empty() ? "integration healthy" : message);
+  ros_accuracy::report(status, accuracy_guard_, simulation_->statistics(), simulation_->integrator_name());
   status.add("scene", simulation_->scene().name);
   status.add("integrator", simulation_->integrator_name());
   status.add("step size [s]", simulation_->step_size());
@@ -103,7 +105,8 @@ void CartSimNode::write_summary(const std::string& outcome) {
   text << ". Steps: " << total_steps_ << " (" << simulation_->statistics().newton_iterations_total
        << " Newton iterations since the last start), wall time " << wall_time << " s (stepping "
        << stepping_wall_time_ << " s), real-time factor " << (wall_time > 0.0 ? simulated_time_ / wall_time : 0.0)
-       << ". Published instants: " << published_instants_ << ".";
+       << ". Published instants: " << published_instants_ << "."
+       << ros_accuracy::summary_sentence(accuracy_guard_, simulation_->statistics(), simulation_->integrator_name());
   if (recorder_) {
     text << " Bag: " << recorder_->current_path() << (record_failure_ ? " (unfinished; " : " (");
     bool first = true;

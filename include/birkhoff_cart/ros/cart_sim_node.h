@@ -26,6 +26,7 @@
 #include <std_srvs/SetBool.h>
 #include <tf2_ros/transform_broadcaster.h>
 
+#include "birkhoff_cart/core/accuracy_guard.h"
 #include "birkhoff_cart/core/simulation.h"
 #include "birkhoff_cart/ros/bag_recorder.h"
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
@@ -82,6 +83,7 @@ class CartSimNode {
   ros::NodeHandle private_node_;
   CartSimParameters parameters_;
   std::unique_ptr<Simulation> simulation_;
+  AccuracyGuard accuracy_guard_;  ///< scene `accuracy` + ~accuracy/...; checked at every publish instant
   std::optional<CommandChannel> steering_channel_;
   std::optional<CommandChannel> drive_channel_;
   std::unique_ptr<BagRecorder> recorder_;

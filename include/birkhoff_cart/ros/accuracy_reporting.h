@@ -1,0 +1,35 @@
+// The accuracy guard in cart_sim (docs/accuracy.md §2): its limits from the scene's `accuracy`
+// section overridden by the private parameters ~accuracy/<quantity>, and how its verdict and the
+// local error estimate reach ~integration_error, /diagnostics and the summary. Translation only:
+// AccuracyGuard (core) decides.
+#pragma once
+
+#include <string>
+
+#include <diagnostic_updater/DiagnosticStatusWrapper.h>
+#include <ros/node_handle.h>
+
+#include "birkhoff_cart/IntegrationError.h"
+#include "birkhoff_cart/core/accuracy_guard.h"
+#include "birkhoff_cart/core/diagnostics.h"
+
+namespace birkhoff_cart {
+namespace ros_accuracy {
+
+/// `scene_requirements` with each ~accuracy/<quantity> parameter applied: the string "off", or a
+/// map {warn: W, error: E} (0 < W ≤ E, finite). Throws std::invalid_argument naming the parameter.
+AccuracyRequirements load_requirements(const ros::NodeHandle& private_node, const AccuracyRequirements& scene_requirements);
+
+/// Fills the guard's fields of an integration_error message (levels and status line).
+void fill(IntegrationError& message, const AccuracyGuard& guard);
+
+/// Raises `status` to the guard's worst level (WARN/ERROR) with its line appended to the message,
+/// and adds the guard's and the estimate's key-values.
+void report(diagnostic_updater::DiagnosticStatusWrapper& status, const AccuracyGuard& guard,
+            const StepStatistics& statistics, const std::string& integrator);
+
+/// " Accuracy: <guard summary>. <local error estimate line>." for the node's summary paragraph.
+std::string summary_sentence(const AccuracyGuard& guard, const StepStatistics& statistics, const std::string& integrator);
+
+}  // namespace ros_accuracy
+}  // namespace birkhoff_cart
