@@ -1,21 +1,29 @@
 // cart_simulate: runs a scene in batch and writes the trajectory as CSV (no ROS master needed).
 //
 //   cart_simulate --scene FILE [--integrator NAME] [--step H] [--tolerance TOL] [--duration T]
-//                 [--output-rate HZ] [--birkhoffian-form F] [--on-accuracy-error fail|warn]
-//                 --output FILE.csv
+//                 [--output-rate HZ] [--birkhoffian-form F] [--quiet]
+//                 [--on-accuracy-error fail|warn] --output FILE.csv
+//   cart_simulate --help | -h | --version
 //
 // Columns: t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,local_error_estimate (SI
 // units; energy is T* [J], p2 the front axle's yaw momentum [kg·m²/s], local_error_estimate the
 // last step's ê [-], empty when the integrator has none: docs/accuracy.md); one row per output
 // instant t0 + k/HZ from the start to the end, both included; values printed with %.17g
 // (round-trip exact). At the end a summary goes to stdout, with the accuracy guard's verdict
-// (the scene's `accuracy` limits, checked at every row).
-// Exit status: 0 done; 2 bad arguments (usage on stderr); 3 unusable scene or settings;
-// 4 a step failed (the rows written so far are kept); 5 the accuracy guard reached ERROR (all rows
-// written; with --on-accuracy-error warn the run exits 0 and the summary still says ERROR).
-#include <algorithm>
+// (the scene's `accuracy` limits, checked at every row). The run is cut
+// into steps by the rule of step_schedule.h (Simulation::step_on_schedule): the last row is at
+// t0 + T exactly.
+// Progress: a run longer than a second of wall time reports, at most once a second on stderr,
+// the percentage of scene time done and the real-time factor (unless --quiet).
+// Exit status: 0 done (also --help, --version); 2 bad arguments (usage on stderr); 3 unusable
+// scene or settings (including the scene time limits), or the CSV cannot be written; 4 a step
+// failed or the run stopped on an unexpected error (the rows written so far are flushed and kept);
+// 5 the accuracy guard reached ERROR (all rows written; with --on-accuracy-error warn the run
+// exits 0 and the summary still says ERROR).
 #include <cerrno>
+#include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -31,6 +39,8 @@
 #include "birkhoff_cart/core/run_summary.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/step_schedule.h"
+#include "birkhoff_cart/core/version.h"
 
 namespace {
 
@@ -42,28 +52,38 @@ constexpr int kExitUsage = 2;
 constexpr int kExitSettings = 3;
 constexpr int kExitStepFailed = 4;
 constexpr int kExitAccuracy = 5;
-constexpr double kCommensurabilityTolerance = 1e-9;  // relative, for "1/HZ is a multiple of h" [-]
+constexpr double kProgressPeriod = 1.0;  // at most one progress line per this much wall time [s]
 
 const char* const kUsage =
     "usage: cart_simulate --scene FILE [--integrator NAME] [--step H] [--tolerance TOL]\n"
-    "                     [--duration T] [--output-rate HZ] [--birkhoffian-form F]\n"
+    "                     [--duration T] [--output-rate HZ] [--birkhoffian-form F] [--quiet]\n"
     "                     [--on-accuracy-error fail|warn] --output FILE.csv\n"
+    "       cart_simulate --help | -h | --version\n"
     "  --scene FILE            scene YAML (config/scenes/*.yaml); it provides every default\n"
     "  --integrator NAME       birkhoff2, birkhoff4, rk2, rk4, dopri5 or midpoint\n"
     "  --step H                step size [s], > 0; 1/HZ must be a whole multiple of it\n"
-    "  --tolerance TOL         dopri5 absolute and relative tolerance [-], > 0\n"
+    "  --tolerance TOL         dopri5 absolute and relative tolerance [-], >= 10 machine epsilon (2.2e-15)\n"
     "  --duration T            simulated time after the start [s], > 0\n"
     "  --output-rate HZ        output rows per simulated second [Hz], > 0\n"
     "  --birkhoffian-form F    autonomous or paper\n"
+    "  --quiet                 no progress lines on stderr\n"
     "  --on-accuracy-error A   fail (default: exit 5 when the scene's accuracy guard reaches ERROR)\n"
     "                          or warn (exit 0; the summary still names the quantity)\n"
     "  --output FILE.csv       where to write t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,\n"
     "                          local_error_estimate\n"
     "The rows are at t0 + k/HZ from the start to the end, both included; when the duration is not a\n"
     "whole number of output intervals, a last row is written at the end time t0 + T itself (reached\n"
-    "by one shorter final step).\n";
+    "by one shorter final step). Scene times are limited so that t + H stays exact to ~1e-6 H\n"
+    "(docs/scenes.md). Runs longer than a second report progress on stderr (once a second at most).\n"
+    "Exit status: 0 done; 2 bad arguments; 3 unusable scene, settings or output file;\n"
+    "4 a step failed or the run stopped (the rows written so far are kept); 5 the accuracy guard\n"
+    "reached ERROR (docs/accuracy.md; the summary on stdout names the quantity).\n";
 
 struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+/// The CSV could not be written (disk full, I/O error): the run stops at once.
+struct OutputError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
@@ -77,6 +97,13 @@ double parse_positive(const std::string& option, const std::string& text) {
   return value;
 }
 
+bool asks_for_help(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0) return true;
+  }
+  return false;
+}
+
 std::map<std::string, std::string> parse_arguments(int argc, char** argv) {
   static const char* const kOptions[] = {"--scene",       "--integrator",       "--step",  "--tolerance",
                                          "--duration",    "--output-rate",      "--birkhoffian-form", "--output",
@@ -84,6 +111,11 @@ std::map<std::string, std::string> parse_arguments(int argc, char** argv) {
   std::map<std::string, std::string> values;
   for (int i = 1; i < argc; ++i) {
     const std::string option = argv[i];
+    if (option == "--quiet") {
+      if (values.count(option)) throw UsageError("option --quiet given twice");
+      values[option] = "";
+      continue;
+    }
     bool known = false;
     for (const char* candidate : kOptions) known = known || option == candidate;
     if (!known) throw UsageError("unknown argument '" + option + "'");
@@ -116,18 +148,11 @@ void apply_overrides(const std::map<std::string, std::string>& arguments, Scene&
   }
 }
 
-/// n such that 1/HZ = n h, or an error when there is no such whole number.
-long steps_per_output(const Scene& scene) {
-  const double ratio = 1.0 / (scene.output_rate * scene.integrator.step_size);
-  const long steps = std::lround(ratio);
-  if (steps < 1 || std::abs(ratio - static_cast<double>(steps)) > kCommensurabilityTolerance * ratio) {
-    char message[256];
-    std::snprintf(message, sizeof message,
-                  "the output interval 1/%.17g s is not a whole number of steps of %.17g s (ratio %.17g)",
-                  scene.output_rate, scene.integrator.step_size, ratio);
-    throw std::invalid_argument(message);
-  }
-  return steps;
+/// The scene key a time limit blames, with the option that may have set it.
+std::string key_with_option(const std::string& key) {
+  if (key == "duration") return "duration (--duration)";
+  if (key == "integrator.step_size") return "integrator.step_size (--step)";
+  return key;
 }
 
 /// One CSV row at `time`, and the accuracy guard's check of the state there.
@@ -147,9 +172,47 @@ void write_row(std::FILE* file, double time, const Simulation& simulation, birkh
   guard.check(time, simulation.diagnostics(), statistics);
 }
 
-}  // namespace
+/// At most one line per kProgressPeriod of wall time: percent of scene time, real-time factor.
+class ProgressReport {
+ public:
+  ProgressReport(bool enabled, double start_time, double end_time)
+      : enabled_(enabled), start_time_(start_time), end_time_(end_time), wall_start_(Clock::now()),
+        next_report_(wall_start_ + std::chrono::duration_cast<Clock::duration>(
+                                       std::chrono::duration<double>(kProgressPeriod))) {}
 
-int main(int argc, char** argv) {
+  void update(double time) {
+    if (!enabled_) return;
+    const Clock::time_point now = Clock::now();
+    if (now < next_report_) return;
+    next_report_ = now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kProgressPeriod));
+    const double wall = std::chrono::duration<double>(now - wall_start_).count();  // [s]
+    const double done = time - start_time_;                                        // [s] of scene time
+    std::fprintf(stderr, "cart_simulate: %5.1f %% of scene time (t = %.6g s of %.6g s), real-time factor %.3g\n",
+                 100.0 * done / (end_time_ - start_time_), time, end_time_, done / wall);
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  bool enabled_;
+  double start_time_, end_time_;  // [s]
+  Clock::time_point wall_start_, next_report_;
+};
+
+/// Closes the CSV; false (with errno) when any write failed.
+bool close_output(std::FILE* file) {
+  const bool write_failed = std::ferror(file) != 0;
+  const int saved_errno = errno;
+  const bool close_failed = std::fclose(file) != 0;
+  if (write_failed && !close_failed) errno = saved_errno != 0 ? saved_errno : EIO;
+  return !write_failed && !close_failed;
+}
+
+int run(int argc, char** argv) {
+  if (asks_for_help(argc, argv)) {
+    std::fputs(kUsage, stdout);
+    return 0;
+  }
+  if (birkhoff_cart::print_version_if_asked(argc, argv, "cart_simulate")) return 0;
   std::map<std::string, std::string> arguments;
   Scene scene;
   try {
@@ -159,24 +222,22 @@ int main(int argc, char** argv) {
   } catch (const UsageError& error) {
     std::fprintf(stderr, "cart_simulate: %s\n%s", error.what(), kUsage);
     return kExitUsage;
-  } catch (const birkhoff_cart::SceneError& error) {
+  } catch (const std::exception& error) {  // SceneError, or e.g. std::bad_alloc while reading
     std::fprintf(stderr, "cart_simulate: %s\n", error.what());
     return kExitSettings;
   }
 
   std::unique_ptr<Simulation> simulation;
-  long steps_between_rows = 0;
-  long output_intervals = 0;
-  bool ends_off_grid = false;  // the end time t0 + duration is not on the 1/HZ grid
+  std::uint64_t steps_between_rows = 0;
   try {
     simulation = std::make_unique<Simulation>(scene);
     const std::string drift = birkhoff_cart::paper_form_drift_warning(scene);  // the eᵗ form's h² drift
     if (!drift.empty()) std::fprintf(stderr, "cart_simulate: %s\n", drift.c_str());
-    steps_between_rows = steps_per_output(scene);
-    const double intervals = scene.duration * scene.output_rate;
-    output_intervals = static_cast<long>(std::floor(intervals * (1.0 + kCommensurabilityTolerance)));
-    ends_off_grid =
-        std::abs(intervals - static_cast<double>(output_intervals)) > kCommensurabilityTolerance * intervals;
+    steps_between_rows = birkhoff_cart::steps_per_interval(1.0 / scene.output_rate, scene.integrator.step_size);
+  } catch (const birkhoff_cart::TimeLimitError& error) {
+    std::fprintf(stderr, "cart_simulate: scene %s with the given options: key '%s': %s\n", scene.source_path.c_str(),
+                 key_with_option(error.key()).c_str(), error.problem().c_str());
+    return kExitSettings;
   } catch (const std::exception& error) {
     std::fprintf(stderr, "cart_simulate: %s\n", error.what());
     return kExitSettings;
@@ -189,38 +250,45 @@ int main(int argc, char** argv) {
     return kExitSettings;
   }
   std::fprintf(file, "t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,local_error_estimate\n");
-  const double start_time = scene.initial_state.time;  // t0 [s]
+  const birkhoff_cart::StepSchedule& schedule = simulation->schedule();
+  const double start_time = schedule.start_time;  // t0 [s]
   birkhoff_cart::AccuracyGuard guard(scene.accuracy);
-  long rows = 0;
+  ProgressReport progress(!arguments.count("--quiet"), start_time, schedule.end_time);
+  std::uint64_t rows = 0;
+  const auto write_state = [&](double time) {
+    write_row(file, time, *simulation, guard);
+    if (std::ferror(file)) throw OutputError(std::string("writing the CSV failed: ") + std::strerror(errno));
+    ++rows;
+  };
   try {
-    for (long k = 0; k <= output_intervals; ++k) {
-      if (k > 0) {
-        for (long n = 0; n < steps_between_rows; ++n) simulation->step();
+    write_state(start_time);
+    // Rows at the whole steps n = k m (t0 + k/HZ, m steps per row) and at the run's end t0 + T.
+    while (!simulation->at_end()) {
+      simulation->step_on_schedule();
+      const std::uint64_t n = simulation->steps_taken();
+      const bool output_instant = n <= schedule.whole_steps && n % steps_between_rows == 0;
+      if (output_instant) {
+        write_state(start_time + static_cast<double>(n / steps_between_rows) / scene.output_rate);
+      } else if (simulation->at_end()) {
+        write_state(schedule.end_time);
       }
-      write_row(file, start_time + static_cast<double>(k) / scene.output_rate, *simulation, guard);
-      ++rows;
+      progress.update(simulation->state().time);
     }
-    if (ends_off_grid) {
-      // The last row is at the end time itself: whole steps while they fit, then one shorter
-      // final step that lands on t0 + duration (the paper's case runs from π/2 to 3.0).
-      const double end_time = simulation->end_time();  // [s]
-      const double h = scene.integrator.step_size;     // [s]
-      while (simulation->state().time + h * (1.0 + kCommensurabilityTolerance) <= end_time) simulation->step();
-      if (end_time - simulation->state().time > kCommensurabilityTolerance * std::max(1.0, std::abs(end_time))) {
-        simulation->step_to(end_time);
-      }
-      write_row(file, end_time, *simulation, guard);
-      ++rows;
-    }
-  } catch (const birkhoff_cart::StepError& error) {
-    std::fflush(file);
-    std::fclose(file);
-    std::fprintf(stderr, "cart_simulate: step failed after t = %.17g s (%ld rows written to %s): %s\n",
-                 simulation->state().time, rows, output_path.c_str(), error.what());
+  } catch (const OutputError& error) {
+    close_output(file);
+    std::fprintf(stderr, "cart_simulate: %s at t = %.17g s (%llu rows complete in %s)\n", error.what(),
+                 simulation->state().time, static_cast<unsigned long long>(rows), output_path.c_str());
+    return kExitSettings;
+  } catch (const std::exception& error) {  // StepError, or anything unexpected: keep the rows
+    const bool kept = close_output(file);
+    std::fprintf(stderr, "cart_simulate: %s after t = %.17g s (%llu rows %s %s): %s\n",
+                 dynamic_cast<const birkhoff_cart::StepError*>(&error) ? "step failed" : "run stopped",
+                 simulation->state().time, static_cast<unsigned long long>(rows),
+                 kept ? "written to" : "NOT all written to", output_path.c_str(), error.what());
     std::printf("cart_simulate %s", birkhoff_cart::run_summary(*simulation, guard).c_str());
     return kExitStepFailed;
   }
-  if (std::fclose(file) != 0) {
+  if (!close_output(file)) {
     std::fprintf(stderr, "cart_simulate: error writing '%s': %s\n", output_path.c_str(), std::strerror(errno));
     return kExitSettings;
   }
@@ -232,4 +300,18 @@ int main(int argc, char** argv) {
     if (!warn_only) return kExitAccuracy;
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // No exception leaves main: run() maps every expected one to its exit status; this is the last net.
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "cart_simulate: unexpected error: %s\n", error.what());
+  } catch (...) {
+    std::fprintf(stderr, "cart_simulate: unexpected error of unknown type\n");
+  }
+  return kExitStepFailed;
 }

@@ -46,6 +46,7 @@
 #include "birkhoff_cart/core/reference_solution.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/version.h"
 
 namespace {
 
@@ -57,7 +58,8 @@ constexpr double kReferenceTolerance = 1e-13;    // dopri5 reference tolerance [
 constexpr double kReferenceCheckTolerance = 1e-12;  // its check run [-]
 constexpr double kPaperStep = 1e-3;              // the paper's τ [s]
 constexpr double kPaperEndMargin = 0.05;         // paper window ends at π − 0.05 [s]
-constexpr double kLongRunCostStep = 0.01;        // birkhoff4 step whose cost the long-run methods match [s]
+constexpr double kLongRunCostStep = 0.01;
+constexpr long kMaxRepetitions = 1000;           // --repetitions limit [-]        // birkhoff4 step whose cost the long-run methods match [s]
 
 // ---------------------------------------------------------------------------------------------
 // Timing
@@ -133,15 +135,15 @@ Scene configured(const Scene& base, const std::string& method, double step, doub
   return scene;
 }
 
-/// Runs the scene to its end; samples residuals every `sample_every` steps (and at the end);
-/// `observer(sim)` (optional) is called at every sample.
-RunErrors run_simulation(Simulation& sim, std::uint64_t steps, std::uint64_t sample_every,
+/// Runs the scene to its end by the shared step schedule (step_schedule.h); samples residuals every
+/// `sample_every` steps (and at the end); `observer(sim)` (optional) is called at every sample.
+RunErrors run_simulation(Simulation& sim, std::uint64_t sample_every,
                          const std::function<void(const Simulation&)>& observer = nullptr) {
   RunErrors errors;
   errors.energy_scale = sim.diagnostics().energy;
-  for (std::uint64_t k = 1; k <= steps; ++k) {
-    sim.step();
-    if (k % sample_every == 0 || k == steps) {
+  while (!sim.at_end()) {
+    sim.step_on_schedule();
+    if (sim.steps_taken() % sample_every == 0 || sim.at_end()) {
       const Diagnostics d = sim.diagnostics();
       errors.max_energy_residual = std::max(errors.max_energy_residual, std::abs(d.energy_balance_residual));
       errors.max_p2_residual = std::max(errors.max_p2_residual, std::abs(d.p2_balance_residual));
@@ -188,7 +190,7 @@ RunRecord measure_ours(const BenchScene& bench, const std::string& method, doubl
     Simulation sim(scene);  // built outside the timed region; reset() restores the initial state
     const RunErrors errors = timed(repetitions, record, [&] {
       sim.reset();
-      RunErrors e = run_simulation(sim, steps, sample_every);
+      RunErrors e = run_simulation(sim, sample_every);
       statistics = sim.statistics();
       return e;
     });
@@ -315,7 +317,7 @@ RunRecord measure_odeint(const BenchScene& bench, const std::string& method, dou
 CartState dopri5_final_state(const Scene& base, double tolerance) {
   const std::uint64_t steps = step_count(base.duration, kSampleInterval);
   Simulation sim(configured(base, "dopri5", base.duration / static_cast<double>(steps), tolerance));
-  for (std::uint64_t k = 0; k < steps; ++k) sim.step();
+  while (!sim.at_end()) sim.step_on_schedule();
   return sim.state();
 }
 
@@ -387,13 +389,11 @@ void write_long_run(const BenchScene& bench, const std::vector<RunRecord>& recor
     const bool adaptive = method == "dopri5";
     const double h = adaptive ? bench.scene.duration / static_cast<double>(step_count(bench.scene.duration, kSampleInterval))
                               : best->step_size;
-    const std::uint64_t steps = step_count(bench.scene.duration, h);
     const std::uint64_t every = std::max<std::uint64_t>(1, std::llround(kLongRunSampleInterval / h));
     Simulation sim(configured(bench.scene, method, h, best->tolerance));
-    std::uint64_t k = 0;
-    for (std::uint64_t n = 1; n <= steps; ++n) {
-      sim.step();
-      if (++k % every == 0) {
+    while (!sim.at_end()) {
+      sim.step_on_schedule();
+      if (sim.steps_taken() % every == 0) {
         const Diagnostics d = sim.diagnostics();
         std::fprintf(out, "%s,%.9g,%.3g,%.6e,%.6f,%.6e,%.6e\n", method.c_str(), best->step_size, best->tolerance,
                      best->cpu_median, sim.state().time, d.energy_balance_residual, d.p2_balance_residual);
@@ -421,16 +421,15 @@ void write_paper_relative_error(const Scene& paper_scene, std::FILE* out) {
     const PaperAnalyticSolution family{paper_scene.initial_state};
     scene.initial_state = family.at(window.start);
     scene.duration = (M_PI - kPaperEndMargin) - window.start;
-    const std::uint64_t steps = static_cast<std::uint64_t>(std::floor(scene.duration / kPaperStep));
     for (const auto& [method, form] : methods) {
       Scene configured_scene = configured(scene, method, kPaperStep, 1e-10);
       configured_scene.integrator.birkhoffian_form = form;
       Simulation sim(configured_scene);
       const PaperAnalyticSolution exact{scene.initial_state};
       try {
-        for (std::uint64_t k = 1; k <= steps; ++k) {
-          sim.step();
-          if (k % 10 == 0 || k == steps) {
+        while (!sim.at_end()) {  // whole steps of τ, then one shorter step onto π − 0.05
+          sim.step_on_schedule();
+          if (sim.steps_taken() % 10 == 0 || sim.at_end()) {
             const CartState& s = sim.state();
             const double truth = exact.at(s.time).arc_length;
             std::fprintf(out, "%s,%s,%s,%.6f,%.12e,%.12e,%.6e\n", window.name, method.c_str(), form.c_str(), s.time,
@@ -465,9 +464,18 @@ Options parse(int argc, char** argv) {
     };
     if (arg == "--quick") options.quick = true;
     else if (arg == "--repetitions") {
-      options.repetitions = std::stoi(value());
+      const std::string text = value();
+      std::size_t used = 0;
+      long repetitions = -1;
+      try {
+        repetitions = std::stol(text, &used);
+      } catch (const std::exception&) {  // not a number, or beyond long
+      }
+      if (used != text.size() || repetitions < 1 || repetitions > kMaxRepetitions) {
+        throw std::invalid_argument("--repetitions needs a whole number in 1..1000, got '" + text + "'");
+      }
+      options.repetitions = static_cast<int>(repetitions);
       repetitions_given = true;
-      if (options.repetitions < 1) throw std::invalid_argument("--repetitions must be >= 1");
     } else if (arg == "--output-dir") options.output_dir = value();
     else if (arg == "--scene-dir") options.scene_dir = value();
     else throw std::invalid_argument("unknown argument '" + arg + "'");
@@ -528,9 +536,27 @@ std::FILE* open_output(const std::string& path) {
 
 }  // namespace
 
+const char* const kUsage =
+    "usage: work_precision [--quick] [--repetitions N] [--output-dir DIR] [--scene-dir DIR]\n"
+    "       work_precision --help | -h | --version\n"
+    "Exit status: 0 done; 1 failed (a file cannot be written, a scene cannot be loaded); 2 bad arguments.\n";
+
 int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    }
+  }
+  if (print_version_if_asked(argc, argv, "work_precision")) return 0;
+  Options options;
   try {
-    const Options options = parse(argc, argv);
+    options = parse(argc, argv);
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "work_precision: %s\n%s", error.what(), kUsage);
+    return 2;
+  }
+  try {
     std::vector<BenchScene> scenes = make_scenes(options);
     const std::string dir = options.output_dir;
     std::FILE* table = open_output(dir + "/work_precision.csv");
@@ -571,6 +597,9 @@ int main(int argc, char** argv) {
     return 0;
   } catch (const std::exception& error) {
     std::fprintf(stderr, "work_precision: %s\n", error.what());
+    return 1;
+  } catch (...) {
+    std::fprintf(stderr, "work_precision: unexpected error of unknown type\n");
     return 1;
   }
 }

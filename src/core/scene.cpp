@@ -10,6 +10,7 @@
 #include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/effect_library.h"
 #include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/step_schedule.h"
 #include "scene_reader.h"
 
 namespace birkhoff_cart {
@@ -155,6 +156,11 @@ Scene read_scene(const SceneReader& reader, const YAML::Node& root, const std::s
     reader.fail("integrator.step_size", "must not exceed the duration");
   }
   scene.output_rate = reader.optional_number(root, "", "output_rate", Range::kPositive, scene.output_rate);
+  try {  // the scene time limits of step_schedule.h (start, end and resolution of t + h)
+    plan_steps(scene.initial_state.time, scene.duration, scene.integrator.step_size);
+  } catch (const TimeLimitError& error) {
+    reader.fail(error.key(), error.problem());
+  }
   scene.effects = scene_detail::read_effects(reader, root["effects"]);
   scene.reference = read_reference(reader, root["reference"], scene.paper_special_case);
   scene.accuracy = scene_detail::read_accuracy(reader, root["accuracy"]);

@@ -38,12 +38,8 @@ Simulation::Simulation(const Scene& scene)
       model_(scene.cart, inertia_model_of(scene)),
       effects_(build_effects(scene.effects, model_)),
       stepper_(make_cart_stepper(scene.integrator, model_, effects_)),
-      state_(scene.initial_state) {
-  if (!(scene_.duration > 0.0) || !std::isfinite(scene_.duration)) {
-    std::ostringstream message;
-    message << "scene duration must be finite and > 0 s, got " << scene_.duration;
-    throw std::invalid_argument(message.str());
-  }
+      state_(scene.initial_state),
+      schedule_(plan_steps(scene.initial_state.time, scene.duration, scene.integrator.step_size)) {
   initial_energy_ = model_.energy(state_);
   initial_steering_momentum_ = model_.steering_momentum(state_);
   reference_ = make_reference_solution(scene_, model_, effects_);
@@ -63,12 +59,23 @@ void Simulation::step() {
   take_step(h, scene_.initial_state.time + static_cast<double>(steps_taken_ + 1) * h);
 }
 
+void Simulation::step_on_schedule() {
+  if (at_end()) {
+    throw std::logic_error("scene '" + scene_.name + "' is already at its end t = " + std::to_string(state_.time) +
+                           " s; reset() before stepping again");
+  }
+  if (steps_taken_ < schedule_.whole_steps) step();
+  else step_to(schedule_.end_time);
+}
+
 void Simulation::step_to(double time) {
   const double remaining = time - state_.time;  // [s]
-  if (!std::isfinite(time) || !(remaining > 0.0) || remaining > scene_.integrator.step_size * (1.0 + 1e-12)) {
+  const double longest = scene_.integrator.step_size * (1.0 + 2.0 * kMinFinalStepFraction);  // [s]
+  if (!std::isfinite(time) || !(remaining > 0.0) || remaining > longest) {
     std::ostringstream message;
-    message << "step_to(" << time << " s) from t = " << state_.time << " s needs 0 < t − tₙ ≤ h = "
-            << scene_.integrator.step_size << " s";
+    message.precision(17);
+    message << "step_to(" << time << " s) from t = " << state_.time << " s needs 0 < t - t_n <= (1 + 2e-5) h = "
+            << longest << " s";
     throw std::invalid_argument(message.str());
   }
   take_step(remaining, time);

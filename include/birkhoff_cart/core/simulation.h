@@ -2,6 +2,12 @@
 // its diagnostics. The time loop belongs to the caller (CLI, node, benchmark): step() advances
 // exactly one step of size h. Failures are transactional: a step that throws leaves the state
 // exactly as it was.
+//
+// Where a run ends and how it is cut into steps is the rule of step_schedule.h, planned once at
+// construction for the scene's t₀, duration and h (schedule()). The scene's whole run is
+//   while (!simulation.at_end()) simulation.step_on_schedule();
+// A caller with another end (the node's ~duration) plans it with plan_steps() and uses step() for
+// the whole steps and step_to(end) for the final one.
 #pragma once
 
 #include <cstdint>
@@ -14,13 +20,15 @@
 #include "birkhoff_cart/core/integrators/cart_stepper.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/state.h"
+#include "birkhoff_cart/core/step_schedule.h"
 
 namespace birkhoff_cart {
 
 class Simulation {
  public:
   /// Builds model, effects and integrator from a validated scene. Throws std::invalid_argument
-  /// naming the problem (unknown integrator, step size ≤ 0, degenerate mass matrix, ...).
+  /// naming the problem (unknown integrator, degenerate mass matrix, ...); TimeLimitError (an
+  /// std::invalid_argument) when t₀, duration or h break a limit of step_schedule.h.
   explicit Simulation(const Scene& scene);
   ~Simulation();
 
@@ -30,6 +38,15 @@ class Simulation {
   const CartState& state() const { return state_; }
   /// The scene's end time t0 + duration [s].
   double end_time() const;
+  /// How the scene's run is cut into steps (plan_steps of t₀, duration, h).
+  const StepSchedule& schedule() const { return schedule_; }
+  /// Steps taken since construction or reset() (whole and final).
+  std::uint64_t steps_taken() const { return steps_taken_; }
+  /// True once the scene's schedule is done: the state is at end_time() exactly.
+  bool at_end() const { return steps_taken_ >= schedule_.total_steps(); }
+  /// The next step of the scene's schedule: step() while whole steps remain, then step_to(end_time())
+  /// if the schedule has a final step. Throws std::logic_error when at_end(), StepError as step().
+  void step_on_schedule();
   double step_size() const { return scene_.integrator.step_size; }
   const std::string& integrator_name() const { return scene_.integrator.name; }
 
@@ -39,7 +56,8 @@ class Simulation {
   void step();
   /// Steps while time + h/2 ≤ `time`.
   void advance_to(double time);
-  /// One final step of size time − t (0 < size ≤ h) that lands exactly on `time`: for an end time
+  /// One final step of size time − t (0 < size ≤ (1 + 2·kMinFinalStepFraction) h: a schedule's final
+  /// step may absorb a sliver) that lands exactly on `time`: for an end time
   /// off the step grid (the paper's case runs from π/2 to 3.0). Afterwards the run is over:
   /// step() throws std::logic_error until reset(). Throws std::invalid_argument for a bad time.
   void step_to(double time);
@@ -65,6 +83,7 @@ class Simulation {
   EffectSet effects_;
   std::unique_ptr<CartStepper> stepper_;
   CartState state_;
+  StepSchedule schedule_;
   void take_step(double step_size, double next_time);
 
   std::uint64_t steps_taken_ = 0;

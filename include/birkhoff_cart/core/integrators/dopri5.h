@@ -19,15 +19,31 @@
 // accepted internal step, in the weighted norm ê of StepStatistics; a simulator step records the
 // sum over its internal steps (propagation ignored). It estimates the 4th-order solution's error
 // while the 5th-order one is propagated (local extrapolation), so it is an upper estimate.
+//
+// Work limits (a tolerance or a time where the controller cannot make progress must end in a named
+// error, not in a run that never ends):
+//   - tolerance ≥ kMinTolerance = 10 ε (ε = 2.2e-16, machine epsilon), the floor of Hairer's DOPRI5
+//     ("RTOL > 10·UROUND"): below it the error estimate is round-off and the controller shrinks the
+//     step without end (10 ms of scene time took 10.7 s at 1e-24, > 30 s at 1e-25). Refused by the
+//     constructor (std::invalid_argument), i.e. when the Simulation is built.
+//   - at most max_internal_steps accepted internal steps per simulator step (default
+//     kMaxInternalSteps = 100000, DOPRI5's NMAX): more ends the step with a StepError naming the
+//     limit. This also bounds the case where the internal step falls below the spacing of doubles
+//     at t (t + dt = t: odeint would loop for ever).
+//   - odeint gives up after 500 rejected trial steps in a row with boost::numeric::odeint::
+//     step_adjustment_error (a std::runtime_error; no_progress_error likewise): caught and
+//     rethrown as a StepError that names it.
 #pragma once
 
 #include <algorithm>
 #include <array>
 #include <boost/numeric/odeint.hpp>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 #include <type_traits>
 
 #include "birkhoff_cart/core/birkhoffian_system.h"
@@ -83,18 +99,27 @@ class DormandPrince5 {
   /// Most accepted internal steps over one simulator step [t, t + h]. Near a singularity (the
   /// paper's case at χ → kπ) the controller's steps shrink without end and the run would hang;
   /// past this count the step fails with a StepError instead (found by the randomized hard cases).
-  static constexpr long kMaxInternalSteps = 100000;
+  static constexpr std::uint64_t kMaxInternalSteps = 100000;  // (DOPRI5's NMAX)
+  /// The smallest tolerance accepted: 10 machine epsilons (≈ 2.2e-15) [-].
+  static constexpr double kMinTolerance = 10.0 * std::numeric_limits<double>::epsilon();
 
-  /// `tolerance`: absolute and relative error tolerance per internal step [-], > 0.
-  explicit DormandPrince5(double tolerance = 1e-10) : tolerance_(tolerance) {
-    if (!(tolerance > 0.0) || !std::isfinite(tolerance)) {
+  /// `tolerance`: absolute and relative error tolerance per internal step [-], finite, ≥ kMinTolerance.
+  /// `max_internal_steps`: accepted internal steps allowed per simulator step [-], ≥ 1.
+  explicit DormandPrince5(double tolerance = 1e-10, std::uint64_t max_internal_steps = kMaxInternalSteps)
+      : tolerance_(tolerance), max_internal_steps_(max_internal_steps) {
+    if (!(tolerance >= kMinTolerance) || !std::isfinite(tolerance)) {
       std::ostringstream message;
-      message << "dopri5 tolerance must be finite and > 0, got " << tolerance;
+      message << "dopri5 tolerance must be finite and >= " << kMinTolerance
+              << " (10 machine epsilons: below it the error estimate is round-off and the step size "
+                 "shrinks without end), got "
+              << tolerance;
       throw std::invalid_argument(message.str());
     }
+    if (max_internal_steps < 1) throw std::invalid_argument("dopri5 max_internal_steps must be >= 1");
   }
 
   double tolerance() const { return tolerance_; }
+  std::uint64_t max_internal_steps() const { return max_internal_steps_; }
   /// The magnitude of the internal step-size guess for the next simulator step [s] (0: none yet, use h).
   double step_size_guess() const { return step_size_guess_; }
   /// Forget the step-size guess (the next step starts from h, as after construction).
@@ -127,19 +152,34 @@ class DormandPrince5 {
     };
 
     // Internal step times, to carry the controller's last free choice to the next simulator step.
+    // odeint calls the observer once per loop turn (before each internal step and at the end), so
+    // counting its calls bounds the work even when t + dt = t.
     double previous_time = t;
     double last_free_step = 0.0;
     const double end_time = t + h;
     double trial_estimate = 0.0;  // ê of the latest trial internal step [-]
     double step_estimate = 0.0;   // Σ ê over the accepted internal steps of [t, t + h] [-]
-    long internal_steps = 0;
+    std::uint64_t internal_steps = 0;
     struct TooManySteps {};
+    double last_taken = 0.0;  // [s]
+    std::uint64_t observer_calls = 0;
+    struct WorkLimitReached {};
     auto observer = [&](const Joint&, double time) {
-      if (time != t && ++internal_steps > kMaxInternalSteps) throw TooManySteps{};
+      if (time != t && ++internal_steps > max_internal_steps_) throw TooManySteps{};
       const double taken = time - previous_time;
       if (time != t && time != end_time) last_free_step = taken;  // not shortened to hit t + h
       if (time != t) step_estimate += trial_estimate;  // the observer sees accepted steps only
+      if (time != t) last_taken = taken;
       previous_time = time;
+      if (++observer_calls > max_internal_steps_ + 1) throw WorkLimitReached{};
+    };
+    const auto fail = [&](const std::string& why) {
+      statistics.rhs_evaluations += evaluations;
+      std::ostringstream message;
+      message.precision(17);
+      message << "dopri5 failed in the step from t = " << t << " s to " << end_time << " s (h = " << h
+              << " s, tolerance " << tolerance_ << "): " << why;
+      throw StepError(message.str());
     };
 
     using Dopri5 = odeint::runge_kutta_dopri5<Joint>;
@@ -155,15 +195,21 @@ class DormandPrince5 {
       statistics.rhs_evaluations += evaluations;
       std::ostringstream message;
       message.precision(17);
-      message << "dopri5 needed more than " << kMaxInternalSteps << " internal steps from t = " << t
+      message << "dopri5 needed more than max_internal_steps = " << max_internal_steps_ << " internal steps from t = " << t
               << " s to " << end_time << " s (stalled at t = " << previous_time << " s; tolerance " << tolerance_
               << "): the solution is singular or too stiff there";
       throw StepError(message.str());
-    } catch (const std::overflow_error& error) {  // odeint: too many rejected steps
-      statistics.rhs_evaluations += evaluations;
-      std::ostringstream message;
-      message << "dopri5 failed at t = " << t << " s: " << error.what();
-      throw StepError(message.str());
+    } catch (const WorkLimitReached&) {
+      std::ostringstream why;
+      why.precision(17);
+      why << "more than max_internal_steps = " << max_internal_steps_
+          << " internal steps (work limit): reached t = " << previous_time << " s with internal steps of "
+          << last_taken << " s";
+      fail(why.str());
+    } catch (const odeint::step_adjustment_error& error) {  // 500 rejected trial steps in a row
+      fail(std::string("odeint step_adjustment_error (no acceptable step size): ") + error.what());
+    } catch (const odeint::odeint_error& error) {  // e.g. no_progress_error
+      fail(std::string("odeint error: ") + error.what());
     }
     statistics.rhs_evaluations += evaluations;
     record_local_error_estimate(statistics, step_estimate);
@@ -176,6 +222,7 @@ class DormandPrince5 {
 
  private:
   double tolerance_;
+  std::uint64_t max_internal_steps_;
   mutable double step_size_guess_ = 0.0;  ///< [s]; mutable: step() is const in the stepper concept
 };
 
