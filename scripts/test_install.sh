@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# The install space works: installs the built workspace into a temporary prefix (never .ws/install)
+# and runs the package from there with nothing of the source tree or devel space in the
+# environment:
+#   1. cart_simulate --version, and a 1 s run of the installed free_coast scene (exit 0, 101 rows),
+#      without sourcing anything (the executables find the package's libraries by their RPATH);
+#   2. with only <prefix>/setup.bash sourced: rospack finds the package in the prefix, and
+#      `roslaunch birkhoff_cart sim.launch` runs 2 s of scene time (fast, recorded) on a private
+#      master and cart_sim ends with "finished".
+# About 30 s on a built workspace. Prints "N passed, N failed" and exits non-zero on a failure.
+#
+# Usage: scripts/test_install.sh        (BIRKHOFF_CART_WORKSPACE=/path/to/ws: a built workspace)
+set -uo pipefail
+# shellcheck source=scripts/workspace.sh
+source "$(dirname "${BASH_SOURCE[0]}")/workspace.sh"  # → $repo, $workspace (set up and built)
+
+prefix="$(mktemp -d /tmp/birkhoff_cart_install.XXXXXX)"
+trap 'rm -rf "$prefix"' EXIT
+passed=0
+failed=0
+check() {  # check NAME COMMAND...: runs COMMAND, counts and reports it
+  local name="$1"
+  shift
+  if "$@" > "$prefix/check.log" 2>&1; then
+    echo "test_install: ok   $name"
+    passed=$((passed + 1))
+  else
+    echo "test_install: FAIL $name"
+    sed 's/^/    /' "$prefix/check.log" | tail -n 30
+    failed=$((failed + 1))
+  fi
+}
+
+echo "== build and install $workspace into $prefix"
+if ! cmake --build "$workspace/build" -- -j2 > "$prefix/build.log" 2>&1 ||
+  ! cmake --install "$workspace/build" --prefix "$prefix" > "$prefix/install.log" 2>&1; then
+  tail -n 30 "$prefix/build.log" "$prefix/install.log"
+  echo "0 passed, 1 failed"
+  exit 1
+fi
+
+# A clean environment: Debian's ROS in /usr, nothing of the workspace or the source tree.
+clean_env=(env -i "HOME=$prefix/home" "PATH=/usr/bin:/bin" "LANG=C.UTF-8" "ROS_HOME=$prefix/ros_home")
+mkdir -p "$prefix/home" "$prefix/ros_home"
+bin="$prefix/lib/birkhoff_cart"
+
+check "cart_simulate --version (unsourced)" "${clean_env[@]}" "$bin/cart_simulate" --version
+check "cart_simulate runs the installed free_coast scene (unsourced)" "${clean_env[@]}" bash -c '
+  "$1/cart_simulate" --scene "$2/share/birkhoff_cart/config/scenes/free_coast.yaml" --duration 1 \
+    --output "$2/free_coast.csv" && test "$(wc -l < "$2/free_coast.csv")" -eq 102' _ "$bin" "$prefix"
+check "cart_sim --version (unsourced)" "${clean_env[@]}" "$bin/cart_sim" --version
+check "rospack finds the package in the prefix" "${clean_env[@]}" bash -c '
+  source "$1/setup.bash" && test "$(rospack find birkhoff_cart)" = "$1/share/birkhoff_cart"' _ "$prefix"
+check "installed message type birkhoff_cart/IntegrationError" "${clean_env[@]}" bash -c '
+  source "$1/setup.bash" && rosmsg show birkhoff_cart/IntegrationError | grep -q .' _ "$prefix"
+
+port="$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("", 0)); print(s.getsockname()[1])')"
+check "roslaunch birkhoff_cart sim.launch, 2 s of scene time, from the prefix" "${clean_env[@]}" bash -c '
+  source "$1/setup.bash" && export ROS_MASTER_URI="http://localhost:$2" &&
+  timeout 120 roslaunch -p "$2" birkhoff_cart sim.launch fast:=true record:=true duration:=2 \
+    bag_path:="$1/sim.bag" summary_path:="$1/summary.txt" < /dev/null &&
+  grep "^cart_sim summary: finished" "$1/summary.txt" && test -s "$1/sim.bag"' _ "$prefix" "$port"
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
