@@ -25,6 +25,7 @@ import re
 import subprocess
 import sys
 import tempfile
+import time
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENE_DIR = os.path.join(REPO, "config", "scenes")
@@ -169,6 +170,7 @@ def main():
     scenes = sorted(os.path.join(SCENE_DIR, f) for f in os.listdir(SCENE_DIR) if f.endswith(".yaml"))
     rng = random.Random(args.seed)
     plans = [choose(rng, scenes) for _ in range(args.runs)]
+    started = time.monotonic()
     counts = collections.Counter()
     reasons = collections.Counter()
     failures = []
@@ -185,8 +187,9 @@ def main():
                 reasons[(kind, reason)] += 1
             if done % 250 == 0:
                 print("cli_sweep: %d of %d runs done" % (done, args.runs), file=sys.stderr, flush=True)
-    print("cli_sweep: %d runs (seed %d): %s" % (args.runs, args.seed,
-                                                 ", ".join("%s: %d" % kv for kv in sorted(counts.items()))))
+    print("cli_sweep: %d runs (seed %d, %d jobs) in %.0f s: %s" % (
+        args.runs, args.seed, args.jobs, time.monotonic() - started,
+        ", ".join("%s: %d" % kv for kv in sorted(counts.items()))))
     for (kind, reason), count in sorted(reasons.items()):
         print("  %-7s %5d  %s" % (kind, count, reason))
     print("%d passed, %d failed" % (args.runs - len(failures), len(failures)))

@@ -20,7 +20,7 @@ double pole_interval(double steering_angle) { return std::floor(steering_angle /
   message.precision(17);
   message << "step from t = " << state.time << " s (h = " << step_size << " s, steering_angle = "
           << state.steering_angle << " rad) would reach the singular steering angle chi = "
-          << std::lround(singular_angle / M_PI) << " pi = " << singular_angle
+          << std::round(singular_angle / M_PI) << " pi = " << singular_angle  // a double: no lround overflow
           << " rad, where det M(chi) = -sin^2(chi) = 0 (paper special case, eq. (3.9)) and omega1, pi1 diverge;";
   message.precision(10);
   message << " singular time t* = " << singular_time << " s; stopped at the last state before it";
