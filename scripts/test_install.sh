@@ -56,7 +56,7 @@ mkdir -p "$destdir/home" "$destdir/ros_home"
 bin="$prefix/lib/birkhoff_cart"
 
 check "cart_simulate --version (unsourced)" "${clean_env[@]}" "$bin/cart_simulate" --version
-check "cart_simulate loads libbirkhoff_cart_core.so from the prefix" bash -c '
+check "cart_simulate loads libbirkhoff_cart_core.so from the prefix" "${clean_env[@]}" bash -c '
   library="$(ldd "$1/cart_simulate" | sed -n "s/^.*libbirkhoff_cart_core.so => \(.*\) (0x.*$/\1/p")" &&
   test "$(readlink -f "$library")" = "$2/lib/libbirkhoff_cart_core.so"' _ "$bin" "$prefix"
 check "cart_simulate runs the installed free_coast scene (unsourced)" "${clean_env[@]}" bash -c '
