@@ -39,7 +39,7 @@ for source in "$repo"/test/unit/*_test.cpp "$repo"/test/ros_unit/*_test.cpp; do
 done
 
 echo "== build ($compiler: $flags) in $workspace"
-# Configure with catkin_make (no build), then make the wanted targets through CMake's Makefile2:
+# Configure with catkin_make (and build the core), then make the wanted targets through CMake's Makefile2:
 # the top-level Makefile builds its goals one after another, Makefile2 builds them in parallel.
 targets=()
 for target in birkhoff_cart_core cart_simulate "${unit_tests[@]}"; do
@@ -51,7 +51,7 @@ set +u
     catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 \
       -DCMAKE_C_COMPILER="$cc" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=None \
       -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
-      -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined" --cmake-only &&
+      -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined" -j2 --make-args birkhoff_cart_core &&
     make -C build -f CMakeFiles/Makefile2 -j2 "${targets[@]}"
 ) > "$workspace/build.log" 2>&1
 build_status=$?
