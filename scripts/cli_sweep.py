@@ -124,7 +124,7 @@ def one_run(binary, budget, scene, start, duration, h, options, directory, index
         problem = check_csv(output, start, end, h, complete=True)
         outcome = ("exit 0", None) if problem is None else ("fail", "exit 0 but " + problem)
     elif result.returncode in (2, 3, 4):
-        first = stderr.splitlines()[0] if stderr else ""
+        first = stderr.splitlines()[-1] if stderr else ""  # the reason: the last line (a drift warning may precede it)
         if not first.startswith("cart_simulate: ") or "unexpected error" in first:
             outcome = ("fail", "exit %d without a named reason: %r" % (result.returncode, first[:200]))
         else:
