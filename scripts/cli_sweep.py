@@ -7,8 +7,8 @@ output rates (mostly whole multiples of the step, some not), integrators, dopri5
 below the floor) and Birkhoffian forms. Each run must end in one of:
   exit 0   with a CSV whose rows are finite, strictly increasing in time, first at t0 and last at
            t0 + T (to 1e-9 h + 4 ulp: grid rows are written at t0 + k/HZ);
-  exit 2/3/4  with one stderr line "cart_simulate: ..." naming the problem (4 keeps the rows
-           written so far, which must still parse);
+  exit 2/3/4/5  with a last stderr line "cart_simulate: ..." naming the problem (4 keeps the rows
+           written so far, which must still parse; 5, the accuracy guard at ERROR, writes them all);
 and never an abort, a crash, another exit status or a run past the time budget (BUDGET s).
 Prints the counts per outcome and per refusal reason, and "N passed, N failed"; exits 1 on a failure.
 
@@ -80,10 +80,10 @@ def check_csv(path, start, end, h, complete):
     times = []
     for number, line in enumerate(lines[1:], start=2):
         fields = line.split(",")
-        if len(fields) != 14:
+        if len(fields) not in (14, 15):  # 15: local_error_estimate, empty for methods without one
             return "line %d has %d fields" % (number, len(fields))
         try:
-            values = [float(v) for v in fields]
+            values = [float(v) for v in fields[:14]] + [float(v) for v in fields[14:] if v]
         except ValueError:
             return "line %d does not parse" % number
         if complete and not all(math.isfinite(v) for v in values):
@@ -123,12 +123,13 @@ def one_run(binary, budget, scene, start, duration, h, options, directory, index
     if result.returncode == 0:
         problem = check_csv(output, start, end, h, complete=True)
         outcome = ("exit 0", None) if problem is None else ("fail", "exit 0 but " + problem)
-    elif result.returncode in (2, 3, 4):
+    elif result.returncode in (2, 3, 4, 5):
         first = stderr.splitlines()[-1] if stderr else ""  # the reason: the last line (a drift warning may precede it)
         if not first.startswith("cart_simulate: ") or "unexpected error" in first:
             outcome = ("fail", "exit %d without a named reason: %r" % (result.returncode, first[:200]))
         else:
-            problem = check_csv(output, start, end, h, complete=False) if result.returncode == 4 else None
+            # 4 keeps the rows so far; 5 (accuracy guard at ERROR) wrote them all
+            problem = check_csv(output, start, end, h, complete=result.returncode == 5) if result.returncode in (4, 5) else None
             outcome = (("exit %d" % result.returncode), reason_of(first)) if problem is None else (
                 "fail", "exit 4 with a broken CSV: " + problem)
     else:
@@ -149,6 +150,7 @@ def reason_of(line):
         (r"internal steps", "dopri5 work limit"),
         (r"step failed", "step failed (StepError)"),
         (r"paper_analytic", "paper_analytic reference off its solution (moved t0)"),
+        (r"^cart_simulate: accuracy", "accuracy guard reached ERROR"),
     ]:
         if re.search(pattern, line):
             return name
