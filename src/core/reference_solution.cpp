@@ -1,5 +1,7 @@
 #include "birkhoff_cart/core/reference_solution.h"
 
+#include "birkhoff_cart/core/shadow_reference.h"
+
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -15,6 +17,8 @@ double relative_error(double value, double reference) {
   return reference == 0.0 ? difference : difference / std::abs(reference);
 }
 
+}  // namespace
+
 /// Fills position, heading and arc-length errors of `state` against `reference`.
 void compare_states(const CartState& state, const CartState& reference, Diagnostics& diagnostics) {
   diagnostics.has_reference = true;
@@ -22,6 +26,8 @@ void compare_states(const CartState& state, const CartState& reference, Diagnost
   diagnostics.reference_heading_error = std::abs(state.heading - reference.heading);                // [rad]
   diagnostics.reference_arc_length_relative_error = relative_error(state.arc_length, reference.arc_length);
 }
+
+namespace {
 
 /// The paper's special case against its closed form (docs eq. (3.9)).
 class PaperAnalyticReference : public ReferenceSolution {
@@ -35,52 +41,6 @@ class PaperAnalyticReference : public ReferenceSolution {
 
  private:
   PaperAnalyticSolution solution_;
-};
-
-/// A second integration of the same scene (same model, effects and commands) with the scene's
-/// shadow integrator, advanced to the simulation's time after each of its steps. When the shadow
-/// step size is smaller, each simulation step is split into n = round(h / h_shadow) equal
-/// sub-steps (n ≥ 1); the last sub-step lands exactly on the simulation's time.
-class ShadowRunReference : public ReferenceSolution {
- public:
-  ShadowRunReference(const IntegratorSettings& settings, const CartState& initial, const CartModel& model,
-                     const EffectSet& effects)
-      : settings_(settings), initial_(initial), model_(model), effects_(effects),
-        stepper_(make_cart_stepper(settings, model, effects)), state_(initial) {}
-
-  void step(double next_time) override {
-    const double h = next_time - state_.time;  // [s]
-    const double ratio = h / settings_.step_size;
-    const long substeps = ratio > 1.0 ? std::lround(ratio) : 1;
-    const double substep = h / static_cast<double>(substeps);  // [s]
-    CartState next = state_;
-    StepStatistics statistics = statistics_;
-    for (long k = 1; k <= substeps; ++k) {
-      stepper_->step(next, substep, statistics);
-      next.time = k == substeps ? next_time : state_.time + static_cast<double>(k) * substep;
-    }
-    state_ = next;
-    statistics_ = statistics;
-  }
-
-  void reset() override {
-    stepper_ = make_cart_stepper(settings_, model_, effects_);  // forgets adaptive step-size guesses
-    state_ = initial_;
-    statistics_ = StepStatistics{};
-  }
-
-  void compare(const CartState& state, Diagnostics& diagnostics) const override {
-    compare_states(state, state_, diagnostics);
-  }
-
- private:
-  IntegratorSettings settings_;
-  CartState initial_;
-  const CartModel& model_;
-  const EffectSet& effects_;
-  std::unique_ptr<CartStepper> stepper_;
-  CartState state_;
-  StepStatistics statistics_;
 };
 
 /// ln tan(t/2) [-], the antiderivative of 1/sin t on (0, π).
@@ -134,7 +94,8 @@ std::unique_ptr<ReferenceSolution> make_reference_solution(const Scene& scene, c
       return std::make_unique<PaperAnalyticReference>(scene.initial_state);
     }
     case ReferenceSettings::Kind::kShadowRun:
-      return std::make_unique<ShadowRunReference>(scene.reference.shadow, scene.initial_state, model, effects);
+      return make_shadow_reference(scene.reference.shadow, scene.integrator.step_size, scene.initial_state, model,
+                                   effects);
   }
   throw std::invalid_argument("unknown reference kind");
 }

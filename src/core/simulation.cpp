@@ -119,6 +119,7 @@ void Simulation::set_steering_command(double torque) {
     throw std::logic_error("scene '" + scene_.name + "' has no steering_torque effect with source 'command'");
   }
   require_finite_torque(torque, "steering");
+  if (reference_ && effects_.steering_command()->value != torque) reference_->command_changes(state_.time);
   effects_.steering_command()->value = torque;
 }
 
@@ -127,6 +128,7 @@ void Simulation::set_drive_command(double torque) {
     throw std::logic_error("scene '" + scene_.name + "' has no drive_torque effect with source 'command'");
   }
   require_finite_torque(torque, "drive");
+  if (reference_ && effects_.drive_command()->value != torque) reference_->command_changes(state_.time);
   effects_.drive_command()->value = torque;
 }
 

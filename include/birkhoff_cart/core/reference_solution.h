@@ -1,6 +1,6 @@
 // What a simulation compares itself against (Scene::reference), computed only when a scene asks:
 //  - paper_analytic: the closed-form solution of the paper's special case (docs eq. (3.9)),
-//  - shadow_run: a second integration of the same scene with another integrator, in lockstep.
+//  - shadow_run: a second integration of the same scene with another integrator (shadow_reference.h).
 #pragma once
 
 #include <cstdint>
@@ -40,9 +40,17 @@ class ReferenceSolution {
   virtual void step(double next_time) = 0;
   /// Back to the initial state.
   virtual void reset() = 0;
+  /// A command input is about to change at the simulation's time `time` [s] (the reference has
+  /// been stepped to it): a reference that integrates the commands must reach `time` with the old
+  /// command held. Default: nothing.
+  virtual void command_changes(double /*time*/) {}
   /// Fills the reference fields of `diagnostics` for the simulated `state`.
   virtual void compare(const CartState& state, Diagnostics& diagnostics) const = 0;
 };
+
+/// Fills the reference fields of `diagnostics`: position, heading and arc-length errors of `state`
+/// against `reference`.
+void compare_states(const CartState& state, const CartState& reference, Diagnostics& diagnostics);
 
 /// Builds the scene's reference (nullptr for ReferenceSettings::Kind::kNone). The model and effects
 /// must outlive it. Throws std::invalid_argument when the scene cannot have that reference (e.g.
