@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
-# Node cost (issue 6, docs/benchmarks.md "Node cost"): cart_sim on the default scene (h = 1 ms,
-# 100 Hz publishing) in fast mode (300 s of scene time, three times each) without and with bag recording (real-time factor from the node's
-# own summary), and in real-time mode (CPU share of one core from /proc/<pid>/stat utime + stime
-# over a 15 s window of wall time). Each case twice: the default scene as shipped (it carries a
-# lockstep dopri5 shadow reference at tolerance 1e-12) and the same scene without the reference. Starts its own roscore on a private port and stops only the
-# processes it started.
+# Node cost (issue 13, docs/benchmarks.md "Node cost"): cart_sim on the default scene (h = 1 ms,
+# 100 Hz publishing, its dopri5 shadow reference on) in fast mode for 300 s of scene time, with and
+# without the bag, beside cart_simulate on the same scene and duration (the bare core with CSV at
+# 100 Hz), three times each; then lockstep with steering_pd_controller (driven.yaml, 60 s at 50 Hz)
+# and real-time mode at 1 kHz (CPU share of one core over 15 s of wall time).
+# Ratios: scene time / wall time (the node's from its own summary: its time loop), and CPU time
+# (user + sys of the whole process, all threads) — the machine is shared, so CPU time is the
+# steadier measure of cost; node/core = node's cost over cart_simulate's.
+# Starts its own roscore on a free port, stops only what it started, removes its scratch directory.
 #
 # Usage: scripts/bench_node_cost.sh [WORKSPACE]     (default .ws; must have cart_sim built)
 set -euo pipefail
@@ -15,73 +18,123 @@ set +u
 # shellcheck disable=SC1091
 source "$workspace/devel/setup.bash"
 set -u
-# A free port (as scripts/run_main.sh): a random one could be another master's, which would then
-# answer below and get our /use_sim_time and nodes.
 port="$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("", 0)); print(s.getsockname()[1])')"
 export ROS_MASTER_URI="http://localhost:$port"
-export ROS_LOG_DIR="$(mktemp -d /tmp/birkhoff_cart_node_cost.XXXXXX)"
+work="$(mktemp -d /tmp/birkhoff_cart_node_cost.XXXXXX)"
+export ROS_LOG_DIR="$work/ros_log"
 scene="$repo/config/scenes/default.yaml"
-node="$workspace/devel/lib/birkhoff_cart/cart_sim"  # not rosrun: workspaces inside the repository hold more than one cart_sim
-work="$ROS_LOG_DIR"
+bin="$workspace/devel/lib/birkhoff_cart"  # not rosrun: workspaces inside the repository hold more than one build
 clock_ticks=$(getconf CLK_TCK)
+duration=300
 
 roscore -p "$port" > "$work/roscore.log" 2>&1 &
 roscore_pid=$!
-trap 'kill "$roscore_pid" 2>/dev/null || true; wait "$roscore_pid" 2>/dev/null || true' EXIT
+cleanup() {
+  kill "$roscore_pid" 2>/dev/null || true
+  wait "$roscore_pid" 2>/dev/null || true
+  rm -rf "$work"
+}
+trap cleanup EXIT
 for _ in $(seq 50); do rosparam list > /dev/null 2>&1 && break; sleep 0.2; done
 if ! kill -0 "$roscore_pid" 2>/dev/null; then
-  echo "bench_node_cost.sh: roscore on port $port did not start (see $work/roscore.log)" >&2
+  echo "bench_node_cost.sh: roscore on port $port did not start" >&2
   exit 1
 fi
 rosparam set /use_sim_time true
 
-# The default scene without its shadow reference (everything else identical).
-scene_without_reference="$work/default_without_reference.yaml"
-awk '/^reference:/ {exit} {print}' "$scene" > "$scene_without_reference"
-printf 'reference:\n  kind: none\n' >> "$scene_without_reference"
+cpu_ticks() { awk '{print $14 + $15}' "/proc/$1/stat"; }  # utime + stime [clock ticks]
 
-cpu_ticks() {  # utime + stime of a process [clock ticks]
-  awk '{print $14 + $15}' "/proc/$1/stat"
+timed() {  # $1 output file for "wall user sys"; the rest: the command
+  local out="$1"; shift
+  /usr/bin/time -f "%e %U %S" -o "$out" "$@"
 }
 
-clear_node_parameters() {  # private parameters outlive the node on the master: a run must not inherit ~bag_path
+node_fast() {  # $1 label, $2 extra parameters -> "node_wall node_loop_rtf node_cpu"
   rosparam delete /cart_sim > /dev/null 2>&1 || true
-}
-
-fast_run() {  # $1 label, $2 scene, $3 extra parameters
-  local summary="$work/summary_$1.txt"
-  clear_node_parameters
   # shellcheck disable=SC2086
-  "$node" __name:=cart_sim _scene:="$2" _step_size:=0.001 _fast:=true \
-    _publish_rate:=100 _duration:=300 _summary_path:="$summary" $3 > "$work/$1.log" 2>&1
-  echo "fast mode, $1: $(grep -o 'wall time [^)]*)[^.]*real-time factor [0-9.e+]*' "$summary")"
-  grep -o 'Bag: .*' "$summary" || true
+  timed "$work/$1.time" "$bin/cart_sim" __name:=cart_sim _scene:="$scene" _step_size:=0.001 _fast:=true \
+    _publish_rate:=100 _duration:=$duration _summary_path:="$work/$1.summary" $2 > "$work/$1.log" 2>&1
+  local rtf; rtf=$(grep -o 'real-time factor [0-9.e+]*' "$work/$1.summary" | awk '{print $3}')
+  awk -v rtf="$rtf" '{printf "%s %s %s", $1, rtf, $2 + $3}' "$work/$1.time"
 }
 
-real_time_run() {  # $1 label, $2 scene: CPU share over 15 s of wall time after a 3 s start-up
-  clear_node_parameters
-  "$node" __name:=cart_sim _scene:="$2" _step_size:=0.001 _fast:=false \
-    _publish_rate:=100 _duration:=25 > "$work/$1.log" 2>&1 &
-  local node_pid=$!
-  sleep 3
-  local ticks0 ticks1 wall0 wall1
-  ticks0=$(cpu_ticks "$node_pid"); wall0=$(date +%s.%N)
-  sleep 15
-  ticks1=$(cpu_ticks "$node_pid"); wall1=$(date +%s.%N)
-  wait "$node_pid" || true
-  awk -v t0="$ticks0" -v t1="$ticks1" -v w0="$wall0" -v w1="$wall1" -v hz="$clock_ticks" -v label="$1" \
-    'BEGIN {printf "real-time mode, %s, h = 1 ms, 100 Hz publishing: CPU %.2f s over %.2f s wall = %.1f%% of one core\n", label, (t1 - t0) / hz, w1 - w0, 100 * (t1 - t0) / hz / (w1 - w0)}'
+core_run() {  # -> "wall cpu"
+  timed "$work/core.time" "$bin/cart_simulate" --scene "$scene" --step 0.001 --output-rate 100 \
+    --duration $duration --output "$work/core.csv" > /dev/null
+  awk '{printf "%s %s", $1, $2 + $3}' "$work/core.time"
 }
 
 echo "load before: $(cat /proc/loadavg)"
-for repetition in 1 2 3; do  # 300 s of scene time each; three times, the machine is shared
-  fast_run "shipped_no_bag_$repetition" "$scene" ""
-  fast_run "shipped_with_bag_$repetition" "$scene" "_bag_path:=$work/shipped.bag"
-  fast_run "no_reference_no_bag_$repetition" "$scene_without_reference" ""
-  fast_run "no_reference_with_bag_$repetition" "$scene_without_reference" "_bag_path:=$work/no_reference.bag"
+printf "%-4s | %-34s | %-34s | %-22s | %s\n" run "node, bag: wall s (loop x) / CPU s" "node, no bag: wall s (loop x) / CPU s" \
+  "cart_simulate: wall / CPU s" "x real time (scene/wall): node bag, core; node/core wall, CPU"
+for repetition in 1 2 3; do
+  read -r bag_wall bag_rtf bag_cpu <<< "$(node_fast "bag_$repetition" "_bag_path:=$work/node.bag")"
+  read -r nobag_wall nobag_rtf nobag_cpu <<< "$(node_fast "nobag_$repetition" "")"
+  read -r core_wall core_cpu <<< "$(core_run)"
+  awk -v r="$repetition" -v bw="$bag_wall" -v br="$bag_rtf" -v bc="$bag_cpu" -v nw="$nobag_wall" -v nr="$nobag_rtf" \
+    -v nc="$nobag_cpu" -v cw="$core_wall" -v cc="$core_cpu" -v T="$duration" \
+    'BEGIN {printf "%-4s | %6.2f (%5.0fx) / %5.2f               | %6.2f (%5.0fx) / %5.2f                 | %6.2f / %5.2f          | node %5.0fx, core %5.0fx; %4.2f, %4.2f\n",
+            r, bw, br, bc, nw, nr, nc, cw, cc, T / bw, T / cw, bw / cw, bc / cc}'
 done
-ls -l "$work"/*.bag | awk '{print "bag " $9 ": " $5 " bytes"}'
-real_time_run shipped "$scene"
-real_time_run no_reference "$scene_without_reference"
+echo "bag: $(ls -l "$work/node.bag" | awk '{print $5}') bytes; $(rosbag info "$work/node.bag" | grep -E '^messages')"
+echo "CPU-time ratios: scene time / CPU time of the process (the machine's load does not enter)"
+for repetition in 1 2 3; do
+  awk -v T="$duration" '{printf "  run: node with bag %5.0fx of its CPU time\n", T / ($2 + $3)}' "$work/bag_$repetition.time"
+done
+awk -v T="$duration" '{printf "  cart_simulate (last run) %5.0fx of its CPU time\n", T / ($2 + $3)}' "$work/core.time"
+
+# Lockstep with the example controller: 60 s of driven.yaml at 50 Hz control.
+rosparam delete /cart_sim > /dev/null 2>&1 || true
+"$bin/steering_pd_controller" __name:=pd > "$work/pd.log" 2>&1 &
+controller_pid=$!
+timed "$work/lockstep.time" "$bin/cart_sim" __name:=cart_sim _scene:="$repo/config/scenes/driven.yaml" _fast:=true \
+  _lockstep:=true _publish_rate:=50 _duration:=60 _summary_path:="$work/lockstep.summary" > "$work/lockstep.log" 2>&1 || true
+kill -INT "$controller_pid" 2>/dev/null || true
+wait "$controller_pid" 2>/dev/null || true
+echo "lockstep (driven.yaml, 60 s at 50 Hz with steering_pd_controller): $(grep -o 'real-time factor [0-9.e+]*' "$work/lockstep.summary") of the loop; $(grep -o 'Lockstep timeouts: [0-9]*' "$work/lockstep.summary"); process wall/user/sys $(cat "$work/lockstep.time")"
+
+# Real time at 1 kHz: CPU share of one core over 15 s after a 3 s start-up.
+rosparam delete /cart_sim > /dev/null 2>&1 || true
+"$bin/cart_sim" __name:=cart_sim _scene:="$scene" _step_size:=0.001 _fast:=false _publish_rate:=100 _duration:=25 \
+  > "$work/real_time.log" 2>&1 &
+node_pid=$!
+sleep 3
+ticks0=$(cpu_ticks "$node_pid"); wall0=$(date +%s.%N)
+sleep 15
+ticks1=$(cpu_ticks "$node_pid"); wall1=$(date +%s.%N)
+wait "$node_pid" || true
+awk -v t0="$ticks0" -v t1="$ticks1" -v w0="$wall0" -v w1="$wall1" -v hz="$clock_ticks" \
+  'BEGIN {printf "real-time mode, default scene, h = 1 ms, 100 Hz publishing: CPU %.2f s over %.2f s wall = %.2f%% of one core\n", (t1 - t0) / hz, w1 - w0, 100 * (t1 - t0) / hz / (w1 - w0)}'
+# Command latency in real-time mode: a responder answers every /clock (published at each 100 Hz
+# publish instant t_k) with a steering_torque at once; the node records each command at the scene
+# time of the step it takes effect after, t_c. t_c - t_k (scene time = wall time at factor 1) is
+# the round trip: transport both ways + the node's wake-up, rounded down to a step.
+rosparam delete /cart_sim > /dev/null 2>&1 || true
+cat > "$work/responder.py" <<'PY'
+import rospy
+from rosgraph_msgs.msg import Clock
+from std_msgs.msg import Float64
+rospy.init_node("latency_responder")
+publisher = rospy.Publisher("steering_torque", Float64, queue_size=100, tcp_nodelay=True)
+rospy.Subscriber("/clock", Clock, lambda clock: publisher.publish(Float64(0.5)), queue_size=100, tcp_nodelay=True)
+rospy.spin()
+PY
+/usr/bin/python3 "$work/responder.py" > "$work/responder.log" 2>&1 &
+responder_pid=$!
+sleep 2
+"$bin/cart_sim" __name:=cart_sim _scene:="$repo/config/scenes/driven.yaml" _fast:=false _publish_rate:=100 _duration:=10 \
+  _bag_path:="$work/latency.bag" > "$work/latency.log" 2>&1 || true
+kill -INT "$responder_pid" 2>/dev/null || true
+wait "$responder_pid" 2>/dev/null || true
+/usr/bin/python3 - "$work/latency.bag" <<'PY'
+import sys, math, rosbag
+stamps = [m.timestamp.to_sec() for m in rosbag.Bag(sys.argv[1]).read_messages(topics=["/steering_torque"])]
+latencies = sorted(t - math.floor(t * 100 + 1e-9) / 100 for t in stamps)
+n = len(latencies)
+if n:
+    print("real-time command latency (answer to each /clock, 10 s, %d commands): median %.1f ms, 90%% %.1f ms, max %.1f ms of scene time (h = 1 ms)"
+          % (n, 1e3 * latencies[n // 2], 1e3 * latencies[int(0.9 * n)], 1e3 * latencies[-1]))
+else:
+    print("real-time command latency: no command recorded")
+PY
 echo "load after:  $(cat /proc/loadavg)"
-echo "logs: $work"

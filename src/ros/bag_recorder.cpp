@@ -19,6 +19,15 @@ std::string bag_directory(const std::string& bag_path) {
   return bag_path.substr(0, slash);
 }
 
+std::string run_bag_path(const std::string& bag_path, std::uint64_t run) {
+  if (run <= 1) return bag_path;
+  const std::string suffix = ".bag";
+  const bool has_suffix =
+      bag_path.size() > suffix.size() && bag_path.compare(bag_path.size() - suffix.size(), suffix.size(), suffix) == 0;
+  const std::string stem = has_suffix ? bag_path.substr(0, bag_path.size() - suffix.size()) : bag_path;
+  return stem + "_run" + std::to_string(run) + (has_suffix ? suffix : "");
+}
+
 std::string disk_space_shortage(const std::string& directory, std::uint64_t free_bytes,
                                 std::uint64_t min_free_bytes) {
   if (min_free_bytes == 0 || free_bytes >= min_free_bytes) return "";
@@ -35,7 +44,7 @@ std::uint64_t free_disk_space(const std::string& directory) {
 }
 
 BagRecorder::BagRecorder(const std::string& path, Compression compression, std::uint64_t min_free_disk_space)
-    : path_(path) {
+    : path_(path), slots_(kQueueCapacity) {
   if (path.empty()) throw BagRecorderError("bag path is empty");
   if (min_free_disk_space > 0) {
     const std::string directory = bag_directory(path);
@@ -60,6 +69,7 @@ BagRecorder::BagRecorder(const std::string& path, Compression compression, std::
     case Compression::kBz2: bag_->setCompression(rosbag::compression::BZ2); break;
   }
   open_ = true;
+  writer_ = std::thread(&BagRecorder::write_queued, this);
 }
 
 BagRecorder::~BagRecorder() {
@@ -70,9 +80,53 @@ BagRecorder::~BagRecorder() {
   }
 }
 
+void BagRecorder::throw_if_unusable() const {
+  if (failure_) throw BagRecorderError(*failure_);
+  if (!open_) throw BagRecorderError("bag " + path_ + " is already closed");
+}
+
+void BagRecorder::write_queued() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (true) {
+    slot_filled_.wait(lock, [this] { return queued_ > 0 || !open_; });
+    if (queued_ == 0) return;  // closed and drained
+    Slot& slot = slots_[next_];
+    if (!failure_) {
+      // The slot is the writer's until released below: the loop fills only free slots.
+      lock.unlock();
+      std::optional<std::string> failed;
+      try {
+        std::visit([&](const auto& message) { bag_->write(slot.topic, slot.time, message); }, slot.message);
+      } catch (const std::exception& error) {
+        failed = "cannot write " + slot.topic + " to bag " + active_path() + ": " + error.what() + free_space_note();
+      }
+      lock.lock();
+      if (failed) {
+        failure_ = failed;
+      } else {
+        ++message_counts_[slot.topic];
+      }
+    }
+    next_ = (next_ + 1) % slots_.size();
+    --queued_;
+    slot_free_.notify_all();
+  }
+}
+
+std::map<std::string, std::uint64_t> BagRecorder::message_counts() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return message_counts_;
+}
+
 void BagRecorder::close() {
-  if (!open_) return;
-  open_ = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!open_) return;
+    open_ = false;
+  }
+  slot_filled_.notify_all();
+  slot_free_.notify_all();
+  if (writer_.joinable()) writer_.join();  // the writer drains the ring first
   try {
     bag_->close();
   } catch (const std::exception& error) {
@@ -80,8 +134,10 @@ void BagRecorder::close() {
     // (std::terminate). Let the half-closed Bag go instead; process exit closes its file, and the
     // chunks already written stay in "<path>.active" for `rosbag reindex`.
     static_cast<void>(bag_.release());
-    throw BagRecorderError("cannot close bag " + active_path() + " (left as it is): " + error.what());
+    throw BagRecorderError("cannot close bag " + active_path() + " (left as it is): " + error.what() +
+                           (failure_ ? " (after: " + *failure_ + ")" : std::string()));
   }
+  if (failure_) throw BagRecorderError(*failure_ + " (bag closed with the messages written before)");
   if (std::rename(active_path().c_str(), path_.c_str()) != 0) {
     throw BagRecorderError("cannot rename " + active_path() + " to " + path_);
   }

@@ -2,6 +2,8 @@
 // state, the diagnostics and the rates all come from the core.
 #include "birkhoff_cart/ros/cart_sim_node.h"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -12,6 +14,12 @@
 #include "birkhoff_cart/ros/instant_schedule.h"
 
 namespace birkhoff_cart {
+namespace {
+
+// What roscpp's own /clock subscription does, for a node that does not publish /clock.
+void hear_clock(const rosgraph_msgs::Clock::ConstPtr& clock) { ros::Time::setNow(clock->clock); }
+
+}  // namespace
 
 CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
     : node_(node), private_node_(private_node) {
@@ -53,9 +61,19 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   } else {
     end_time_ = start_time + parameters_.duration;
   }
+  // ros::Time holds 32-bit seconds: a stamp at or past 2^32 s throws in roscpp. Refuse such a run
+  // here by name; a run without end that gets there stops cleanly with exit 4 (run()).
+  if (!(start_time < ros_conversions::kLatestRosTime) ||
+      (std::isfinite(end_time_) && !(end_time_ < ros_conversions::kLatestRosTime))) {
+    throw NodeStartupError("scene " + parameters_.scene_path + " runs from t = " + format_seconds(start_time) +
+                           " s to t = " + format_seconds(end_time_) +
+                           " s: cart_sim publishes scene time as ROS time, which ends before 2^32 s = " +
+                           format_seconds(ros_conversions::kLatestRosTime) + " s");
+  }
   publish_period_ = 1.0 / parameters_.publish_rate;
-  effective_real_time_factor_ = parameters_.real_time_factor;
-  if (!parameters_.fast && effective_real_time_factor_ == 0.0) effective_real_time_factor_ = 1.0;
+  double real_time_factor = parameters_.real_time_factor;
+  if (!parameters_.fast && real_time_factor == 0.0) real_time_factor = 1.0;
+  pacing_ = WallClockPacing(real_time_factor);
 
   if (simulation_->accepts_steering_command()) {
     steering_channel_.emplace(simulation_->steering_command(), parameters_.max_steering_torque,
@@ -66,26 +84,60 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
                            start_time);
   }
 
+  // The lockstep barrier: the command topics named by ~lockstep_topics, by default every one the
+  // scene takes commands on.
+  if (parameters_.lockstep) {
+    const auto wanted = [this](const std::string& topic) {
+      if (!parameters_.lockstep_topics_given) return true;
+      return std::find(parameters_.lockstep_topics.begin(), parameters_.lockstep_topics.end(), topic) !=
+             parameters_.lockstep_topics.end();
+    };
+    expect_steering_ = wanted("steering_torque");
+    expect_drive_ = wanted("drive_torque");
+    if ((expect_steering_ && !steering_channel_) || (expect_drive_ && !drive_channel_)) {
+      if (parameters_.lockstep_topics_given) {
+        throw NodeStartupError("~lockstep_topics names a command topic whose effect in scene " +
+                               parameters_.scene_path + " has no 'command' source");
+      }
+      expect_steering_ = expect_steering_ && steering_channel_.has_value();
+      expect_drive_ = expect_drive_ && drive_channel_.has_value();
+    }
+  }
+
   // The record comes first: a node that cannot keep its record does not run at all.
   if (!parameters_.bag_path.empty()) {
     try {
-      recorder_ = std::make_unique<BagRecorder>(parameters_.bag_path,
-                                                BagRecorder::parse_compression(parameters_.bag_compression),
-                                                parameters_.min_free_disk_space);
+      open_record(parameters_.bag_path);
     } catch (const std::exception& error) {
       throw NodeStartupError(std::string("cannot record (~bag_path): ") + error.what());
     }
   }
 
+  // Every subscription and service of the node goes through callback_queue_.
+  node_.setCallbackQueue(&callback_queue_);
+  private_node_.setCallbackQueue(&callback_queue_);
   odometry_publisher_ = node_.advertise<nav_msgs::Odometry>("odom", 50);
   joint_state_publisher_ = node_.advertise<sensor_msgs::JointState>("joint_states", 50);
   integration_error_publisher_ = private_node_.advertise<IntegrationError>("integration_error", 50);
-  if (parameters_.publish_clock) clock_publisher_ = node_.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  // /clock through a NodeHandle whose own remapping keeps it /clock: main() remaps roscpp's internal
+  // /clock subscription of this process away (kUnheardClockTopic), so the node does not hear back
+  // every /clock it publishes; it sets its own ROS time instead (publish_clock()). Without
+  // ~publish_clock it hears /clock from the clock source as any node does.
+  ros::NodeHandle clock_node(node_, "", ros::M_string{{"/clock", "/clock"}});
+  if (parameters_.publish_clock) {
+    clock_publisher_ = clock_node.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  } else if (ros::Time::isSimTime()) {
+    clock_subscriber_ = clock_node.subscribe("/clock", 1, &hear_clock);
+  }
   if (parameters_.publish_tf) transform_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
   // Subscriptions exist for every scene, so a command for an effect without a command source is
   // counted and reported instead of vanishing.
-  steering_subscriber_ = node_.subscribe("steering_torque", 20, &CartSimNode::on_steering_torque, this);
-  drive_subscriber_ = node_.subscribe("drive_torque", 20, &CartSimNode::on_drive_torque, this);
+  // tcpNoDelay: a command is one small message; Nagle's algorithm would hold it back (lockstep
+  // waits for it every publish instant).
+  steering_subscriber_ = node_.subscribe("steering_torque", 20, &CartSimNode::on_steering_torque, this,
+                                         ros::TransportHints().tcpNoDelay());
+  drive_subscriber_ = node_.subscribe("drive_torque", 20, &CartSimNode::on_drive_torque, this,
+                                      ros::TransportHints().tcpNoDelay());
   reset_service_ = private_node_.advertiseService("reset", &CartSimNode::on_reset, this);
   pause_service_ = private_node_.advertiseService("pause", &CartSimNode::on_pause, this);
 
@@ -95,11 +147,11 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
 
   paused_ = parameters_.start_paused;
   restart_schedule();
-  ROS_INFO("cart_sim: scene '%s' (%s), integrator %s, h = %g s, %s mode, publish %g Hz, end t = %s s%s%s",
+  ROS_INFO("cart_sim: scene '%s' (%s), integrator %s, h = %g s, %s mode%s, publish %g Hz, end t = %s s%s%s",
            simulation_->scene().name.c_str(), parameters_.scene_path.c_str(), simulation_->integrator_name().c_str(),
-           simulation_->step_size(), parameters_.fast ? "fast" : "real-time", parameters_.publish_rate,
-           format_seconds(end_time_).c_str(), recorder_ ? ", recording to " : "",
-           recorder_ ? parameters_.bag_path.c_str() : "");
+           simulation_->step_size(), parameters_.fast ? "fast" : "real-time", parameters_.lockstep ? ", lockstep" : "",
+           parameters_.publish_rate, format_seconds(end_time_).c_str(), recorder_ ? ", recording to " : "",
+           recorder_ ? recorder_->path().c_str() : "");
 }
 
 CartSimNode::~CartSimNode() = default;
@@ -109,57 +161,120 @@ void CartSimNode::restart_schedule() {
   next_diagnostic_index_ = 1;
   clock_started_ = false;
   last_transform_stamp_ = ros::Time();
-  pace_anchor_wall_ = ros::WallTime::now();
-  pace_anchor_time_ = simulation_->state().time;
+  pacing_.restart(WallClockPacing::Clock::now(), simulation_->state().time);
 }
 
 bool CartSimNode::end_reached() const {
   return simulation_->state().time + 0.5 * simulation_->step_size() > end_time_;
 }
 
-int CartSimNode::run() {
-  run_start_wall_ = ros::WallTime::now();
-  pace_anchor_wall_ = run_start_wall_;
-  std::string outcome = "finished";
+bool CartSimNode::stop_requested() const { return shutdown_signal_received() || !ros::ok(); }
+
+bool CartSimNode::take_step() {
+  apply_watchdogs();
+  const double time_before = simulation_->state().time;
+  try {
+    simulation_->step();
+  } catch (const StepError& error) {
+    step_failure_ = error.what();
+    return false;
+  }
+  ++period_steps_;
+  ++total_steps_;
+  simulated_time_ += simulation_->state().time - time_before;
+  if (!clock_started_) {  // the first /clock, t0 + h, unless that is a publish instant (published there)
+    clock_started_ = true;
+    const double start = simulation_->scene().initial_state.time;
+    const double time = simulation_->state().time;
+    if (start + static_cast<double>(next_publish_index_) * publish_period_ > time + 0.5 * simulation_->step_size()) {
+      publish_clock(time);
+    }
+  }
+  return true;
+}
+
+int CartSimNode::run_loop(std::string& outcome) {
+  using Clock = WallClockPacing::Clock;
+  const double start = simulation_->scene().initial_state.time;
   while (true) {
-    if (shutdown_signal_received() || !ros::ok()) {
+    if (stop_requested()) {
       outcome = "interrupted (shutdown requested)";
       break;
     }
     if (record_failure_) break;  // a command could not be recorded (set in a callback, also while paused)
     if (paused_) {
-      process_callbacks(0.02);
-      pace_anchor_wall_ = ros::WallTime::now();
-      pace_anchor_time_ = simulation_->state().time;
+      wait_while_paused();
       continue;
     }
     if (end_reached()) break;
-    apply_watchdogs();
-    const double time_before = simulation_->state().time;
-    const ros::WallTime step_start = ros::WallTime::now();
-    try {
-      simulation_->step();
-    } catch (const StepError& error) {
-      step_failure_ = error.what();
-      break;
+    // One batch: the steps up to the next publish instant (or the end). Between steps, callbacks
+    // run when the transport has queued one (not in lockstep, where they run only at the barrier);
+    // in real-time mode the node sleeps until a step is due.
+    const double instant = start + static_cast<double>(next_publish_index_) * publish_period_;
+    const double half_step = 0.5 * simulation_->step_size();
+    Clock::time_point batch_start = Clock::now();
+    bool failed = false;
+    bool interrupted = false;
+    while (!end_reached() && simulation_->state().time + half_step < instant) {
+      // Real time: a step is due once the wall clock has reached its scene time (half a step early
+      // is fine). Steps due are run back to back; only a node that has caught up runs callbacks or
+      // sleeps, so a command takes effect at the first step after its arrival in scene time too.
+      const double next_time = simulation_->state().time + simulation_->step_size();
+      const bool step_due = !pacing_.paced() || pacing_.scene_time_at(Clock::now()) >= next_time - half_step;
+      if ((!step_due || !pacing_.paced()) && !parameters_.lockstep && callback_queue_.pending()) {
+        const std::uint64_t resets_before = resets_;
+        process_callbacks();
+        if (paused_ || record_failure_ || stop_requested() || resets_ != resets_before) {
+          interrupted = true;  // paused, failed, stopping, or reset (time went back): a new batch
+          break;
+        }
+        if (!step_due) continue;
+      }
+      if (!step_due) {
+        const double elapsed = std::chrono::duration<double>(Clock::now() - batch_start).count();
+        stepping_wall_time_ += elapsed;
+        period_stepping_wall_time_ += elapsed;
+        wait_until_due(std::min(instant, end_time_));
+        batch_start = Clock::now();
+        if (paused_ || record_failure_ || stop_requested()) {
+          interrupted = true;
+          break;
+        }
+        continue;
+      }
+      if (!take_step()) {
+        failed = true;
+        break;
+      }
     }
-    const double step_wall_time = (ros::WallTime::now() - step_start).toSec();
-    stepping_wall_time_ += step_wall_time;
-    period_stepping_wall_time_ += step_wall_time;
-    ++period_steps_;
-    ++total_steps_;
-    simulated_time_ += simulation_->state().time - time_before;
-
+    const double batch_wall_time = std::chrono::duration<double>(Clock::now() - batch_start).count();
+    stepping_wall_time_ += batch_wall_time;
+    period_stepping_wall_time_ += batch_wall_time;
+    if (failed) break;
+    if (interrupted) continue;
     const double time = simulation_->state().time;
-    const bool publish_due = pass_due_instants(simulation_->scene().initial_state.time, publish_period_, time,
-                                               0.5 * simulation_->step_size(), next_publish_index_);
-    if (!clock_started_ || publish_due) publish_clock(time);
-    clock_started_ = true;
-    if (publish_due) {
+    if (pass_due_instants(start, publish_period_, time, half_step, next_publish_index_)) {
+      publish_clock(time);
       publish_instant();
       if (record_failure_) break;
+      if (parameters_.lockstep) wait_for_commands(time);
     }
-    pace();
+  }
+  return 0;
+}
+
+int CartSimNode::run() {
+  if (parameters_.lockstep) wait_for_controllers();
+  run_start_wall_ = WallClockPacing::Clock::now();
+  pacing_.restart(run_start_wall_, simulation_->state().time);
+  std::string outcome = "finished";
+  std::optional<std::string> internal_error;
+  try {
+    run_loop(outcome);
+  } catch (const std::exception& error) {
+    // Anything else that escapes the loop (e.g. roscpp refusing a time): a clear line, the bag
+    // closed, exit 4; never std::terminate with the record left unfinished.
+    internal_error = error.what();
   }
 
   if (step_failure_) {
@@ -167,26 +282,35 @@ int CartSimNode::run() {
     outcome = "step failure: " + *step_failure_;
     diagnostic_updater_->force_update();
   }
+  if (internal_error) {
+    ROS_FATAL("cart_sim: stopped at t = %.9g s by an unexpected error: %s", simulation_->state().time,
+              internal_error->c_str());
+    outcome = "internal error: " + *internal_error;
+  }
   if (record_failure_) {
     ROS_ERROR("cart_sim: bag write failed at t = %.9g s, stopping (the node does not run without its record): %s",
               simulation_->state().time, record_failure_->c_str());
   }
-  if (recorder_) {
-    try {
-      recorder_->close();
-    } catch (const std::exception& error) {
-      // Keep the first cause (the failed write); the close failure follows it.
-      record_failure_ = record_failure_ ? *record_failure_ + "; then " + error.what() : std::string(error.what());
-    }
-  }
+  finish_record();
   if (record_failure_) {
     ROS_FATAL("cart_sim: the record failed: %s", record_failure_->c_str());
     outcome = "record failure: " + *record_failure_;
   }
   write_summary(outcome);
+  if (internal_error) return kExitInternalError;
   if (step_failure_) return kExitStepFailure;
   if (record_failure_) return kExitRecordFailure;
   return kExitFinished;
+}
+
+void CartSimNode::finish_record() {
+  if (!recorder_) return;
+  try {
+    recorder_->close();
+  } catch (const std::exception& error) {
+    // Keep the first cause (the failed write); the close failure follows it.
+    record_failure_ = record_failure_ ? *record_failure_ + "; then " + error.what() : std::string(error.what());
+  }
 }
 
 void CartSimNode::apply_watchdogs() {

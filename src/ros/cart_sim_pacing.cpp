@@ -1,28 +1,108 @@
-// cart_sim's pacing: callbacks between steps and the wall-clock schedule of real-time mode (see cart_sim_node.h).
+// cart_sim's pacing (see cart_sim_node.h): callbacks between steps, the absolute wall-clock
+// deadlines of real-time mode, pauses and the lockstep barrier.
 #include "birkhoff_cart/ros/cart_sim_node.h"
 
 #include <algorithm>
-
-#include <ros/callback_queue.h>
+#include <chrono>
 
 namespace birkhoff_cart {
+namespace {
 
-void CartSimNode::process_callbacks(double wall_timeout) {
-  ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(std::max(0.0, wall_timeout)));
+using Clock = WallClockPacing::Clock;
+
+// Longest single sleep [s]: a SIGINT/SIGTERM (whose handler cannot wake a condition) is seen
+// within this time.
+constexpr double kLongestSleep = 0.1;
+
+Clock::time_point after(double seconds) {
+  return Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
 }
 
-void CartSimNode::pace() {
-  if (effective_real_time_factor_ <= 0.0) {
-    process_callbacks(0.0);
-    return;
+}  // namespace
+
+void CartSimNode::process_callbacks() { callback_queue_.call_pending(); }
+
+bool CartSimNode::wait_until_due(double time) {
+  // The deadline is computed from the anchor on every wake: a reset or pause in a callback moves
+  // the anchor, and the next wait follows it.
+  while (!stop_requested()) {
+    const Clock::time_point deadline = std::min(pacing_.due(time), after(kLongestSleep));
+    if (callback_queue_.wait_until(deadline)) {
+      return false;  // a message: the caller runs the steps due by now, then the callbacks
+    }
+    if (Clock::now() >= pacing_.due(time)) return true;
   }
-  // Wall time at which the current scene time is due: anchor + (t − t_anchor)/factor.
-  const double due_wall = (simulation_->state().time - pace_anchor_time_) / effective_real_time_factor_;
-  while (true) {
-    const double remaining = due_wall - (ros::WallTime::now() - pace_anchor_wall_).toSec();
-    process_callbacks(std::min(remaining, 0.02));
-    if (remaining <= 0.0 || paused_ || shutdown_signal_received() || !ros::ok()) break;
+  return false;
+}
+
+void CartSimNode::wait_while_paused() {
+  const Clock::time_point start = Clock::now();
+  callback_queue_.wait_until(after(kLongestSleep));
+  process_callbacks();
+  paused_wall_time_ += std::chrono::duration<double>(Clock::now() - start).count();
+  // Scene time stood still: the next deadline starts from now.
+  pacing_.restart(Clock::now(), simulation_->state().time);
+}
+
+void CartSimNode::wait_for_controllers() {
+  const auto connected = [this] {
+    return (!expect_steering_ || steering_subscriber_.getNumPublishers() > 0) &&
+           (!expect_drive_ || drive_subscriber_.getNumPublishers() > 0) &&
+           joint_state_publisher_.getNumSubscribers() > 0;
+  };
+  Clock::time_point next_note = after(parameters_.lockstep_timeout);
+  while (!connected() && !stop_requested()) {
+    callback_queue_.wait_until(after(0.01));
+    process_callbacks();
+    if (Clock::now() >= next_note) {
+      ROS_WARN("cart_sim: lockstep: waiting for a controller (publishers on %s%s%s and a joint_states subscriber)",
+               expect_steering_ ? steering_subscriber_.getTopic().c_str() : "",
+               expect_steering_ && expect_drive_ ? " and " : "",
+               expect_drive_ ? drive_subscriber_.getTopic().c_str() : "");
+      next_note = after(parameters_.lockstep_timeout);
+    }
   }
+}
+
+void CartSimNode::wait_for_commands(double time) {
+  const Clock::time_point give_up = after(parameters_.lockstep_timeout);
+  const auto answered = [this] {
+    return (!expect_steering_ || steering_answered_) && (!expect_drive_ || drive_answered_);
+  };
+  // Callbacks run only here in lockstep: everything queued since the last barrier (the answers,
+  // ~pause, ~reset) takes effect at this instant.
+  process_callbacks();
+  while (!answered() && !stop_requested() && !paused_) {
+    const Clock::time_point now = Clock::now();
+    if (now >= give_up) {
+      ++lockstep_timeouts_;
+      ROS_WARN("cart_sim: lockstep: no answer on %s%s%s within %g s of wall time after t = %.6g s; going on "
+               "(%lu timeouts so far)",
+               expect_steering_ && !steering_answered_ ? "steering_torque" : "",
+               expect_steering_ && !steering_answered_ && expect_drive_ && !drive_answered_ ? " and " : "",
+               expect_drive_ && !drive_answered_ ? "drive_torque" : "", parameters_.lockstep_timeout, time,
+               static_cast<unsigned long>(lockstep_timeouts_));
+      break;
+    }
+    callback_queue_.wait_until(std::min(give_up, now + std::chrono::duration_cast<Clock::duration>(
+                                                           std::chrono::duration<double>(kLongestSleep))));
+    process_callbacks();
+  }
+  steering_answered_ = false;
+  drive_answered_ = false;
+  std::stable_sort(lockstep_records_.begin(), lockstep_records_.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (const auto& [topic, message] : lockstep_records_) {
+    if (!recorder_ || record_failure_) break;
+    try {
+      recorder_->write(topic, ros_conversions::to_ros_time(time), message);
+    } catch (const std::exception& failure) {
+      record_failure_ = failure.what();
+    }
+  }
+  lockstep_records_.clear();
+  // The wait is the controllers' time, not the simulator's: real-time pacing starts again here.
+  if (pacing_.paced()) pacing_.restart(Clock::now(), simulation_->state().time);
 }
 
 }  // namespace birkhoff_cart

@@ -78,7 +78,18 @@ CartSimParameters load_parameters(const ros::NodeHandle& private_node) {
   parameters.max_drive_torque = read_double(p, "max_drive_torque", parameters.max_drive_torque);
   require(std::isfinite(parameters.max_drive_torque) && parameters.max_drive_torque > 0.0,
           "~max_drive_torque must be > 0 N·m");
+  parameters.lockstep = read_parameter<bool>(p, "lockstep", parameters.lockstep);
+  parameters.lockstep_topics_given = p.hasParam("lockstep_topics");
+  parameters.lockstep_topics = read_parameter<std::vector<std::string>>(p, "lockstep_topics", parameters.lockstep_topics);
+  for (const std::string& topic : parameters.lockstep_topics) {
+    require(topic == "steering_torque" || topic == "drive_torque",
+            "~lockstep_topics may hold only steering_torque and drive_torque, got '" + topic + "'");
+  }
+  parameters.lockstep_timeout = read_double(p, "lockstep_timeout", parameters.lockstep_timeout);
+  require(std::isfinite(parameters.lockstep_timeout) && parameters.lockstep_timeout > 0.0,
+          "~lockstep_timeout must be > 0 s of wall time");
   parameters.bag_path = read_parameter<std::string>(p, "bag_path", parameters.bag_path);
+  parameters.record_wall_time = read_parameter<bool>(p, "record_wall_time", parameters.record_wall_time);
   parameters.bag_compression = read_parameter<std::string>(p, "bag_compression", parameters.bag_compression);
   BagRecorder::parse_compression(parameters.bag_compression);  // throws naming the bad value
   // [bytes]; read as a number so sizes beyond a 32-bit XmlRpc int (2 GiB) can be given as 1.6e10.

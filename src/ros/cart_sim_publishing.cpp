@@ -13,6 +13,9 @@ void CartSimNode::publish_clock(double time) {
   rosgraph_msgs::Clock clock;
   clock.clock = ros_conversions::to_ros_time(time);
   clock_publisher_.publish(clock);
+  // This process does not hear its own /clock (main() remaps roscpp's subscription away): its ROS
+  // time (log stamps, diagnostics) is set here instead.
+  if (ros::Time::isSimTime()) ros::Time::setNow(clock.clock);
 }
 
 void CartSimNode::publish_instant() {
@@ -40,6 +43,7 @@ void CartSimNode::publish_instant() {
   }
   ++published_instants_;
   if (recorder_ && !record_failure_) {
+    if (!parameters_.record_wall_time) error.wall_time_per_step = 0.0;  // the one field that differs between runs
     try {
       recorder_->write(integration_error_publisher_.getTopic(), error.header.stamp, error);
       recorder_->write(odometry_publisher_.getTopic(), odometry.header.stamp, odometry);

@@ -16,6 +16,14 @@ void CartSimNode::receive_command(CommandChannel& channel, const std::string& to
     ROS_WARN_THROTTLE(1.0, "cart_sim: %s command %g clamped to %g N·m", topic.c_str(), message.data,
                       channel.torque());
   }
+  if (steering_channel_ && &channel == &*steering_channel_) steering_answered_ = true;
+  if (drive_channel_ && &channel == &*drive_channel_) drive_answered_ = true;
+  if (parameters_.lockstep) {
+    // Answers arrive over separate connections in any order; they are recorded at the barrier in
+    // the order of the topics' names, so two identical runs record identical bags.
+    lockstep_records_.emplace_back(topic, message);
+    return;
+  }
   if (recorder_ && !record_failure_) {
     try {
       recorder_->write(topic, ros_conversions::to_ros_time(std::max(time, 0.0)), message);
@@ -48,6 +56,7 @@ void CartSimNode::on_drive_torque(const std_msgs::Float64::ConstPtr& message) {
 bool CartSimNode::on_reset(std_srvs::Empty::Request& /*request*/, std_srvs::Empty::Response& /*response*/) {
   simulation_->reset();
   accuracy_guard_.reset();
+  ++resets_;
   const double start_time = simulation_->state().time;
   if (steering_channel_) {
     steering_channel_->restart(start_time);
@@ -58,8 +67,28 @@ bool CartSimNode::on_reset(std_srvs::Empty::Request& /*request*/, std_srvs::Empt
     simulation_->set_drive_command(drive_channel_->torque());
   }
   restart_schedule();
-  ROS_INFO("cart_sim: reset to the scene's initial state at t = %.6g s", start_time);
+  // Each run gets its own bag: one bag across a reset would hold overlapping times of two runs,
+  // which playback interleaves.
+  if (recorder_ && !record_failure_) {
+    try {
+      recorder_->close();
+      ROS_INFO("cart_sim: run %lu recorded to %s", static_cast<unsigned long>(run_index_), recorder_->path().c_str());
+      open_record(parameters_.bag_path);
+    } catch (const std::exception& failure) {
+      record_failure_ = std::string("at ~reset: ") + failure.what();
+    }
+  }
+  ROS_INFO("cart_sim: reset to the scene's initial state at t = %.6g s%s%s", start_time,
+           recorder_ && !record_failure_ ? ", recording to " : "",
+           recorder_ && !record_failure_ ? recorder_->path().c_str() : "");
   return true;
+}
+
+void CartSimNode::open_record(const std::string& path) {
+  ++run_index_;
+  recorder_ = std::make_unique<BagRecorder>(run_bag_path(path, run_index_),
+                                            BagRecorder::parse_compression(parameters_.bag_compression),
+                                            parameters_.min_free_disk_space);
 }
 
 bool CartSimNode::on_pause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response) {

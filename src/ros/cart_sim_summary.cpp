@@ -3,6 +3,7 @@
 #include "birkhoff_cart/ros/accuracy_reporting.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -12,8 +13,7 @@ namespace birkhoff_cart {
 
 void CartSimNode::produce_diagnostics(diagnostic_updater::DiagnosticStatusWrapper& status) {
   const Diagnostics diagnostics = simulation_->diagnostics();
-  const double wall_elapsed = (ros::WallTime::now() - run_start_wall_).toSec();
-  const double real_time_factor = wall_elapsed > 0.0 ? simulated_time_ / wall_elapsed : 0.0;
+  const double real_time_factor = this->real_time_factor();
 
   struct Check {
     const char* name;
@@ -85,11 +85,17 @@ void CartSimNode::produce_diagnostics(diagnostic_updater::DiagnosticStatusWrappe
   add_channel("drive_torque", drive_channel_);
 }
 
+double CartSimNode::real_time_factor() const {
+  const double running_wall_time =
+      std::chrono::duration<double>(WallClockPacing::Clock::now() - run_start_wall_).count() - paused_wall_time_;
+  return running_wall_time > 0.0 ? simulated_time_ / running_wall_time : 0.0;
+}
+
 void CartSimNode::write_summary(const std::string& outcome) {
   const CartState& state = simulation_->state();
   const Diagnostics diagnostics = simulation_->diagnostics();
   const Eigen::Vector2d rear_axle_midpoint = simulation_->model().rear_axle_midpoint(state);
-  const double wall_time = (ros::WallTime::now() - run_start_wall_).toSec();
+  const double wall_time = std::chrono::duration<double>(WallClockPacing::Clock::now() - run_start_wall_).count();
   std::ostringstream text;
   text << std::setprecision(9);
   text << "cart_sim summary: " << outcome << ". Scene '" << simulation_->scene().name << "', integrator "
@@ -104,9 +110,10 @@ void CartSimNode::write_summary(const std::string& outcome) {
   }
   text << ". Steps: " << total_steps_ << " (" << simulation_->statistics().newton_iterations_total
        << " Newton iterations since the last start), wall time " << wall_time << " s (stepping "
-       << stepping_wall_time_ << " s), real-time factor " << (wall_time > 0.0 ? simulated_time_ / wall_time : 0.0)
+       << stepping_wall_time_ << " s, paused " << paused_wall_time_ << " s), real-time factor " << real_time_factor()
        << ". Published instants: " << published_instants_ << "."
        << ros_accuracy::summary_sentence(accuracy_guard_, simulation_->statistics(), simulation_->integrator_name());
+  if (parameters_.lockstep) text << " Lockstep timeouts: " << lockstep_timeouts_ << ".";
   if (recorder_) {
     text << " Bag: " << recorder_->current_path() << (record_failure_ ? " (unfinished; " : " (");
     bool first = true;

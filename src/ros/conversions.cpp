@@ -47,9 +47,9 @@ const std::array<std::string, 5>& joint_names() {
 }
 
 ros::Time to_ros_time(double time) {
-  if (!std::isfinite(time) || time < 0.0) {
+  if (!std::isfinite(time) || time < 0.0 || time >= kLatestRosTime) {
     throw std::invalid_argument("scene time " + std::to_string(time) +
-                                " s cannot be a ROS time (must be finite and >= 0)");
+                                " s cannot be a ROS time (must be finite, >= 0 and < 2^32 - 1 s)");
   }
   return ros::Time(time);
 }

@@ -43,22 +43,25 @@ inline bool set_paused(const std::string& service, bool paused) {
   return ros::service::call(service, call) && call.response.success;
 }
 
-/// cart_sim lives beside the test executable (devel/lib/birkhoff_cart/), found through
-/// /proc/self/exe. Not through rosrun: it searches the whole package tree and may find several
-/// workspaces' builds.
-inline std::string cart_sim_executable() {
+/// An executable of this package, beside the test executable (devel/lib/birkhoff_cart/), found
+/// through /proc/self/exe. Not through rosrun: it searches the whole package tree and may find
+/// several workspaces' builds.
+inline std::string package_executable(const std::string& name) {
   std::array<char, 4096> path{};
   const ssize_t length = ::readlink("/proc/self/exe", path.data(), path.size() - 1);
   std::string self(path.data(), length > 0 ? static_cast<std::size_t>(length) : 0);
-  return self.substr(0, self.find_last_of('/') + 1) + "cart_sim";
+  return self.substr(0, self.find_last_of('/') + 1) + name;
 }
 
-/// Starts cart_sim as a child process (fork + execv) with `arguments` (ROS remappings and
-/// _private:=value parameters). With a non-empty `log` its stdout and stderr go to that file;
-/// otherwise they stay the test's. Returns the child's pid (≤ 0 when fork failed); a child that
-/// cannot exec cart_sim exits 127.
-inline pid_t start_cart_sim(const std::vector<std::string>& arguments, const std::string& log = "") {
-  const std::string executable = cart_sim_executable();
+inline std::string cart_sim_executable() { return package_executable("cart_sim"); }
+
+/// Starts the package's executable `name` as a child process (fork + execv) with `arguments` (ROS
+/// remappings and _private:=value parameters). With a non-empty `log` its stdout and stderr go to
+/// that file; otherwise they stay the test's. Returns the child's pid (≤ 0 when fork failed); a
+/// child that cannot exec exits 127.
+inline pid_t start_program(const std::string& name, const std::vector<std::string>& arguments,
+                           const std::string& log = "") {
+  const std::string executable = package_executable(name);
   std::vector<std::string> storage = {executable};
   storage.insert(storage.end(), arguments.begin(), arguments.end());
   const pid_t pid = ::fork();
@@ -77,6 +80,11 @@ inline pid_t start_cart_sim(const std::vector<std::string>& arguments, const std
     ::_exit(127);
   }
   return pid;
+}
+
+/// start_program("cart_sim", ...).
+inline pid_t start_cart_sim(const std::vector<std::string>& arguments, const std::string& log = "") {
+  return start_program("cart_sim", arguments, log);
 }
 
 /// Waits up to `timeout` [s of wall time] for the child `pid` and returns its exit status; −1 when

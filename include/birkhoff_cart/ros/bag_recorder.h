@@ -4,17 +4,34 @@
 //
 // Disk space: before opening, the recorder can refuse a directory with less free space than a
 // minimum (cart_sim's ~min_free_disk_space), so a node never starts a record it cannot keep. A disk
-// that fills during the run makes write() throw; close() then closes what it can.
+// that fills during the run makes write() (or close()) throw; close() then closes what it can.
+//
+// Threading: rosbag's serialization, LZ4 compression and file calls run on the recorder's own
+// writer thread. write() copies the message into a bounded ring of reused slots (no allocation in
+// steady state) and returns; when the ring is full it waits for the writer (back pressure: no
+// message is ever dropped). close() drains the ring, closes and renames the bag; the destructor
+// does the same, so every exit path that unwinds the stack leaves a complete bag.
 #pragma once
 
+#include <condition_variable>
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <thread>
+#include <variant>
+#include <vector>
 
+#include <nav_msgs/Odometry.h>
 #include <ros/time.h>
 #include <rosbag/bag.h>
+#include <sensor_msgs/JointState.h>
+#include <std_msgs/Float64.h>
+
+#include "birkhoff_cart/IntegrationError.h"
 
 namespace birkhoff_cart {
 
@@ -26,6 +43,10 @@ class BagRecorderError : public std::runtime_error {
 
 /// The directory that holds `bag_path` ("." for a bare file name, "/" for a file at the root).
 std::string bag_directory(const std::string& bag_path);
+
+/// Where run `run` (1, 2, ...) of a node recording to `bag_path` goes: run 1 at `bag_path`, run
+/// k > 1 (after k − 1 resets) at "<stem>_run<k>.bag" ("<path>_run<k>" without a .bag suffix).
+std::string run_bag_path(const std::string& bag_path, std::uint64_t run);
 
 /// The decision of the free-space check (pure): "" when `free_bytes` ≥ `min_free_bytes` or
 /// `min_free_bytes` is 0 (check disabled); otherwise a message naming `directory`, the free bytes
@@ -40,10 +61,15 @@ std::uint64_t free_disk_space(const std::string& directory);
 class BagRecorder {
  public:
   enum class Compression { kNone, kLz4, kBz2 };
+  /// The message types the node records (one slot of the ring holds any of them).
+  using Message = std::variant<nav_msgs::Odometry, sensor_msgs::JointState, IntegrationError, std_msgs::Float64>;
+  /// Slots of the ring between the time loop and the writer thread [messages].
+  static constexpr std::size_t kQueueCapacity = 1024;
 
-  /// Opens "<path>.active" for writing. Throws BagRecorderError when it cannot (missing or
-  /// unwritable directory, empty path, ...) or, with `min_free_disk_space` > 0 [bytes], when the
-  /// bag's directory has less free space than that (checked before anything is created).
+  /// Opens "<path>.active" for writing and starts the writer thread. Throws BagRecorderError when
+  /// it cannot (missing or unwritable directory, empty path, ...) or, with `min_free_disk_space` >
+  /// 0 [bytes], when the bag's directory has less free space than that (checked before anything
+  /// is created).
   BagRecorder(const std::string& path, Compression compression = Compression::kLz4,
               std::uint64_t min_free_disk_space = 0);
   /// Closes the bag (see close()); never throws.
@@ -51,23 +77,31 @@ class BagRecorder {
   BagRecorder(const BagRecorder&) = delete;
   BagRecorder& operator=(const BagRecorder&) = delete;
 
-  /// Writes one message on `topic` at `time` (scene time; clamped to ROS's smallest bag time,
-  /// 1 ns, so a command received at t = 0 is kept). Throws BagRecorderError on a write failure.
-  template <class Message>
-  void write(const std::string& topic, const ros::Time& time, const Message& message) {
-    if (!open_) throw BagRecorderError("bag " + path_ + " is already closed");
-    try {
-      bag_->write(topic, time < ros::TIME_MIN ? ros::TIME_MIN : time, message);
-    } catch (const std::exception& error) {
-      throw BagRecorderError("cannot write " + topic + " to bag " + active_path() + ": " + error.what() +
-                             free_space_note());
+  /// Queues one message on `topic` at `time` (scene time; clamped to ROS's smallest bag time,
+  /// 1 ns, so a command received at t = 0 is kept); waits while the ring is full. Throws
+  /// BagRecorderError when an earlier write failed on the writer thread or the bag is closed.
+  template <class M>
+  void write(const std::string& topic, const ros::Time& time, const M& message) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    slot_free_.wait(lock, [this] { return queued_ < slots_.size() || failure_ || !open_; });
+    throw_if_unusable();
+    Slot& slot = slots_[(next_ + queued_) % slots_.size()];
+    slot.topic = topic;  // reuses the slot's capacity
+    slot.time = time < ros::TIME_MIN ? ros::TIME_MIN : time;
+    if (M* held = std::get_if<M>(&slot.message)) {
+      *held = message;
+    } else {
+      slot.message = message;
     }
-    ++message_counts_[topic];
+    ++queued_;
+    lock.unlock();
+    slot_filled_.notify_one();
   }
 
-  /// Flushes, closes and renames the bag to its final path. Idempotent. Throws BagRecorderError
-  /// when rosbag cannot finish the file (e.g. the disk is full): the bag then stays
-  /// "<path>.active" with the chunks already on disk (`rosbag reindex` may recover them).
+  /// Drains the ring, flushes, closes and renames the bag to its final path. Idempotent. Throws
+  /// BagRecorderError when a write failed or rosbag cannot finish the file (e.g. the disk is
+  /// full): the bag then stays "<path>.active" with the chunks already on disk (`rosbag reindex`
+  /// may recover them).
   void close();
   bool is_open() const { return open_; }
 
@@ -78,22 +112,41 @@ class BagRecorder {
   /// Where the bag is now: path() after a successful close(), active_path() otherwise (still
   /// open, or left unfinished by a failed close).
   std::string current_path() const { return finished_ ? path_ : active_path(); }
-  /// Messages written per topic.
-  const std::map<std::string, std::uint64_t>& message_counts() const { return message_counts_; }
+  /// Messages written to the file per topic (complete after close()).
+  std::map<std::string, std::uint64_t> message_counts() const;
 
   /// "lz4" → kLz4, "bz2" → kBz2, "none" → kNone; throws std::invalid_argument otherwise.
   static Compression parse_compression(const std::string& name);
 
  private:
+  struct Slot {
+    std::string topic;
+    ros::Time time;
+    Message message;
+  };
+
+  /// The writer thread: writes queued slots in order until closed and drained.
+  void write_queued();
+  /// Throws BagRecorderError for a failed writer or a closed bag (mutex_ held).
+  void throw_if_unusable() const;
   /// " (N bytes free in DIR)" after a failed write: rosbag's own messages ("Error seeking",
   /// "Problem writing data to disk") do not say that the disk is full. "" when statvfs fails.
   std::string free_space_note() const;
 
   std::string path_;
   std::unique_ptr<rosbag::Bag> bag_;
-  bool open_ = false;
+  bool open_ = false;      ///< accepting writes (mutex_)
   bool finished_ = false;  ///< closed and renamed to path_
+
+  mutable std::mutex mutex_;
+  std::condition_variable slot_free_;    ///< the writer freed a slot (or failed)
+  std::condition_variable slot_filled_;  ///< the loop queued a slot (or closes)
+  std::vector<Slot> slots_;
+  std::size_t next_ = 0;    ///< the slot the writer takes next
+  std::size_t queued_ = 0;  ///< filled slots not yet written
+  std::optional<std::string> failure_;   ///< the writer's first failure
   std::map<std::string, std::uint64_t> message_counts_;
+  std::thread writer_;
 };
 
 }  // namespace birkhoff_cart

@@ -2,15 +2,20 @@
 // ROS; this class only translates). Every private parameter is read once in load_parameters() and
 // documented in README.md, "ROS interface" (meaning, unit, default).
 //
-// Time: the node steps the simulation in lockstep and publishes /clock itself (run with
-// /use_sim_time true); message stamps are the scene's time t (scene time t is ROS time t). The
-// first /clock is one step after the start (t0 + h), never 0. Fast mode runs as fast as possible
-// (or at ~real_time_factor); real-time mode is paced by the wall clock. Between steps the node
-// processes its callbacks, so commands take effect at deterministic scene times.
+// Time: the node steps the simulation and publishes /clock itself (run with /use_sim_time true);
+// message stamps are the scene's time t (scene time t is ROS time t). The first /clock is one step
+// after the start (t0 + h), never 0. Three ways to run (README.md, "Running modes"):
+//  - fast: as fast as possible (or at ~real_time_factor). Callbacks run at the first step after the
+//    transport queued them (SignalingCallbackQueue's flag, one atomic load per step).
+//  - real time: paced by absolute wall-clock deadlines (WallClockPacing); the node sleeps until the
+//    next publish instant is due or a message arrives, then runs the steps due by then.
+//  - lockstep: at every publish instant the node publishes the state and /clock, then waits until
+//    every expected command topic has answered (or ~lockstep_timeout), and callbacks run only
+//    there, so a closed loop through another node is the same on every run.
 //
 // The member functions are defined by job: cart_sim_node.cpp (construction and the time loop),
-// cart_sim_pacing.cpp, cart_sim_publishing.cpp, cart_sim_services.cpp (commands, ~reset, ~pause)
-// and cart_sim_summary.cpp (diagnostics and the final summary).
+// cart_sim_pacing.cpp (callbacks, real-time deadlines, the lockstep barrier), cart_sim_publishing.cpp,
+// cart_sim_services.cpp (commands, ~reset, ~pause) and cart_sim_summary.cpp (diagnostics, summary).
 #pragma once
 
 #include <atomic>
@@ -18,6 +23,8 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
@@ -33,6 +40,8 @@
 #include "birkhoff_cart/ros/command_channel.h"
 #include "birkhoff_cart/ros/conversions.h"
 #include "birkhoff_cart/ros/shutdown_signals.h"
+#include "birkhoff_cart/ros/signaling_callback_queue.h"
+#include "birkhoff_cart/ros/wall_clock_pacing.h"
 
 namespace birkhoff_cart {
 
@@ -49,6 +58,8 @@ class CartSimNode {
   static constexpr int kExitStepFailure = 1;  ///< a StepError stopped the simulation
   static constexpr int kExitStartupFailure = 2;  ///< the constructor threw NodeStartupError (main's exit)
   static constexpr int kExitRecordFailure = 3;   ///< the bag could not be written
+  static constexpr int kExitInternalError = 4;   ///< an unexpected exception left the loop (bag closed)
+  static constexpr int kExitForced = kForcedExitCode;        ///< a second SIGINT/SIGTERM: quick exit after a flush
 
   /// Loads parameters and scene, builds the simulation, opens the bag, advertises. Throws
   /// NodeStartupError with a message naming the problem.
@@ -62,36 +73,65 @@ class CartSimNode {
   const CartSimParameters& parameters() const { return parameters_; }
 
  private:
+  int run_loop(std::string& outcome);
+  void finish_record();
+
+  // cart_sim_services.cpp
   void on_steering_torque(const std_msgs::Float64::ConstPtr& message);
   void on_drive_torque(const std_msgs::Float64::ConstPtr& message);
   void receive_command(CommandChannel& channel, const std::string& topic, const std_msgs::Float64& message);
   bool on_reset(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   bool on_pause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
+  void open_record(const std::string& path);
 
+  // cart_sim_node.cpp
   void restart_schedule();
   void apply_watchdogs();
+  bool end_reached() const;
+  /// One step (watchdogs first); false when it failed (step_failure_ set).
+  bool take_step();
+
+  // cart_sim_publishing.cpp
   void publish_clock(double time);
   void publish_instant();
+
+  // cart_sim_pacing.cpp
+  /// Runs the queued callbacks (commands, services) now.
+  void process_callbacks();
+  /// Real-time mode: sleeps until scene time `time` [s] is due or a message arrives; runs the
+  /// callbacks of an arrival. True when `time` is due.
+  bool wait_until_due(double time);
+  /// Paused: waits for a message (~pause, ~reset) or 0.1 s; counts the paused wall time.
+  void wait_while_paused();
+  /// Lockstep: after publishing instant `time` [s], waits for every expected command topic.
+  void wait_for_commands(double time);
+  /// Lockstep, before the first step: waits until every expected command topic has a publisher
+  /// and joint_states a subscriber (a state published before would be lost and its barrier time out).
+  void wait_for_controllers();
+  bool stop_requested() const;
+
+  // cart_sim_summary.cpp
   void produce_diagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
-  /// Processes callbacks; waits up to `wall_timeout` [s] for one when > 0.
-  void process_callbacks(double wall_timeout);
-  void pace();
   void write_summary(const std::string& outcome);
-  bool end_reached() const;
+  /// Real-time factor over the run: scene time advanced / wall time not paused [-].
+  double real_time_factor() const;
 
   ros::NodeHandle node_;
   ros::NodeHandle private_node_;
+  SignalingCallbackQueue callback_queue_;  ///< every subscription and service of the node
   CartSimParameters parameters_;
   std::unique_ptr<Simulation> simulation_;
   AccuracyGuard accuracy_guard_;  ///< scene `accuracy` + ~accuracy/...; checked at every publish instant
   std::optional<CommandChannel> steering_channel_;
   std::optional<CommandChannel> drive_channel_;
   std::unique_ptr<BagRecorder> recorder_;
+  std::uint64_t run_index_ = 0;  ///< runs recorded so far (a reset starts the next run's bag)
 
   ros::Publisher odometry_publisher_;
   ros::Publisher joint_state_publisher_;
   ros::Publisher integration_error_publisher_;
   ros::Publisher clock_publisher_;
+  ros::Subscriber clock_subscriber_;  ///< /clock from elsewhere when ~publish_clock is false
   ros::Subscriber steering_subscriber_;
   ros::Subscriber drive_subscriber_;
   ros::ServiceServer reset_service_;
@@ -101,25 +141,33 @@ class CartSimNode {
 
   double end_time_ = 0.0;                 ///< scene time at which the run stops [s]; +inf = never
   double publish_period_ = 0.01;          ///< [s]
-  double effective_real_time_factor_ = 0; ///< pacing; 0 = unlimited
+  WallClockPacing pacing_;
   std::uint64_t next_publish_index_ = 1;  ///< k of the next publish instant t0 + k/publish_rate
   std::uint64_t next_diagnostic_index_ = 1;
   bool clock_started_ = false;            ///< the first /clock (t0 + h) went out
   bool paused_ = false;
+  std::uint64_t resets_ = 0;              ///< ~reset calls served
   ros::Time last_transform_stamp_;        ///< never the same tf stamp twice
   std::optional<std::string> step_failure_;
   std::optional<std::string> record_failure_;
 
+  // Lockstep: topics expected at each publish instant and those answered since it.
+  bool expect_steering_ = false;
+  bool expect_drive_ = false;
+  bool steering_answered_ = false;
+  bool drive_answered_ = false;
+  std::uint64_t lockstep_timeouts_ = 0;
+  std::vector<std::pair<std::string, std_msgs::Float64>> lockstep_records_;  ///< commands to record at the barrier
+
   // Work measurement (wall clock) for integration_error, diagnostics and the summary.
-  ros::WallTime run_start_wall_;
-  double stepping_wall_time_ = 0.0;           ///< wall time spent inside step() since the start [s]
+  WallClockPacing::Clock::time_point run_start_wall_;
+  double paused_wall_time_ = 0.0;             ///< wall time spent paused [s]
+  double stepping_wall_time_ = 0.0;           ///< wall time spent in step batches since the start [s]
   double period_stepping_wall_time_ = 0.0;    ///< ... since the last publish instant [s]
   std::uint64_t period_steps_ = 0;
   double last_wall_time_per_step_ = 0.0;      ///< [s]
   std::uint64_t total_steps_ = 0;             ///< steps over the whole run, resets included
   double simulated_time_ = 0.0;               ///< scene time advanced over the whole run [s]
-  ros::WallTime pace_anchor_wall_;
-  double pace_anchor_time_ = 0.0;
   std::uint64_t published_instants_ = 0;
   std::uint64_t diagnostics_rejections_seen_ = 0;
 };

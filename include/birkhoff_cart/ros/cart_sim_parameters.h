@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <ros/node_handle.h>
 
@@ -23,7 +24,12 @@ struct CartSimParameters {
   double command_timeout = 0.5;              ///< ~command_timeout: watchdog silence [s of scene time]; 0 = off
   double max_steering_torque = 100.0;        ///< ~max_steering_torque: clamp [N·m]
   double max_drive_torque = 200.0;           ///< ~max_drive_torque: clamp [N·m]
+  bool lockstep = false;                     ///< ~lockstep: wait for the controllers at every publish instant
+  std::vector<std::string> lockstep_topics;  ///< ~lockstep_topics: topics to wait for; default: every command topic the scene takes
+  bool lockstep_topics_given = false;        ///< ~lockstep_topics was set (even to [])
+  double lockstep_timeout = 5.0;             ///< ~lockstep_timeout: wait at most [s of wall time], then go on with a warning
   std::string bag_path;                      ///< ~bag_path: record here; "" = no record
+  bool record_wall_time = true;              ///< ~record_wall_time: false records integration_error.wall_time_per_step as 0 (bit-identical bags)
   std::string bag_compression = "lz4";       ///< ~bag_compression: lz4, bz2 or none
   std::uint64_t min_free_disk_space = 16u << 20;  ///< ~min_free_disk_space: refuse to record below [bytes]; 0 = no check
   std::string summary_path;                  ///< ~summary_path: also write the final summary here; "" = no file

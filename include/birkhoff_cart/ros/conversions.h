@@ -35,8 +35,11 @@ struct ActuatorEfforts {
   double drive_torque = 0.0;     ///< T, total on the rear axle, split equally on φ1, φ2 [N·m]
 };
 
+/// The end of ROS time: ros::Time holds unsigned 32-bit seconds, so t < 2^32 − 1 s [s].
+constexpr double kLatestRosTime = 4294967295.0;
+
 /// Scene time t [s] as ROS time (scene time t is ROS time t). Throws std::invalid_argument for a
-/// negative or non-finite time.
+/// negative or non-finite time, or one at or past kLatestRosTime.
 ros::Time to_ros_time(double time);
 
 /// nav_msgs/Odometry of base_link (A, heading θ) in odom; twist in base_link:

@@ -4,7 +4,15 @@
 
 namespace birkhoff_cart {
 
-/// Installs the SIGINT/SIGTERM handlers. Call once after ros::init(..., NoSigintHandler).
+/// Exit code after a second SIGINT/SIGTERM: the process leaves at once (128 + SIGINT).
+constexpr int kForcedExitCode = 130;
+
+/// Where roscpp's own /clock subscription of a clock source is remapped to (cart_sim's main), so
+/// the process does not hear back the /clock it publishes. Nothing is published there.
+constexpr const char* kUnheardClockTopic = "/birkhoff_cart/unheard_clock";
+
+/// Installs the SIGINT/SIGTERM handlers: the first signal asks for a clean shutdown, a second one
+/// exits at once with kForcedExitCode. Call once after ros::init(..., NoSigintHandler).
 void install_shutdown_signal_handlers();
 /// True once SIGINT/SIGTERM arrived.
 bool shutdown_signal_received();

@@ -1,4 +1,10 @@
 // cart_sim: the simulator node (README.md, "ROS interface"). All the work is in CartSimNode.
+// Exit codes: 0 finished or interrupted, 1 step failure, 2 refused at start, 3 record failure,
+// 4 unexpected error (bag closed), 130 a second SIGINT/SIGTERM (bag left as <path>.active).
+#include <cstdio>
+#include <string>
+#include <vector>
+
 #include <ros/ros.h>
 
 #include "birkhoff_cart/core/version.h"
@@ -6,7 +12,16 @@
 
 int main(int argc, char** argv) {
   if (birkhoff_cart::print_version_if_asked(argc, argv, "cart_sim")) return 0;
-  ros::init(argc, argv, "cart_sim", ros::init_options::NoSigintHandler);
+  // Log lines reach a file (roslaunch output="log", a redirect) as they happen, not at exit.
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  // roscpp subscribes every process to /clock under sim time; the clock source would hear back
+  // each /clock it publishes (a thread wake-up each, ~1 µs per step in fast mode). Remap that
+  // internal subscription away; CartSimNode publishes on the real /clock and sets its own time.
+  std::vector<char*> arguments(argv, argv + argc);
+  std::string unheard_clock = std::string("/clock:=") + birkhoff_cart::kUnheardClockTopic;
+  arguments.push_back(unheard_clock.data());
+  int argument_count = static_cast<int>(arguments.size());
+  ros::init(argument_count, arguments.data(), "cart_sim", ros::init_options::NoSigintHandler);
   birkhoff_cart::install_shutdown_signal_handlers();
   // Outlives the node: when the last NodeHandle dies roscpp shuts down and drops later log output,
   // so the FATAL message below would be lost.
@@ -17,5 +32,8 @@ int main(int argc, char** argv) {
   } catch (const birkhoff_cart::NodeStartupError& error) {
     ROS_FATAL("cart_sim: %s", error.what());
     return birkhoff_cart::CartSimNode::kExitStartupFailure;
+  } catch (const std::exception& error) {  // run() catches its own; this is construction or teardown
+    ROS_FATAL("cart_sim: unexpected error: %s", error.what());
+    return birkhoff_cart::CartSimNode::kExitInternalError;
   }
 }
