@@ -215,12 +215,18 @@ int CartSimNode::run_loop(std::string& outcome) {
     Clock::time_point batch_start = Clock::now();
     bool failed = false;
     bool interrupted = false;
+    double due_scene_time = -std::numeric_limits<double>::infinity();  // [s]
     while (!end_reached() && simulation_->state().time + half_step < instant) {
       // Real time: a step is due once the wall clock has reached its scene time (half a step early
       // is fine). Steps due are run back to back; only a node that has caught up runs callbacks or
       // sleeps, so a command takes effect at the first step after its arrival in scene time too.
       const double next_time = simulation_->state().time + simulation_->step_size();
-      const bool step_due = !pacing_.paced() || pacing_.scene_time_at(Clock::now()) >= next_time - half_step;
+      // The scene time due by now is read from the clock only when the last reading no longer
+      // covers the next step (one clock read per catch-up, not per step).
+      if (pacing_.paced() && due_scene_time < next_time - half_step) {
+        due_scene_time = pacing_.scene_time_at(Clock::now());
+      }
+      const bool step_due = !pacing_.paced() || due_scene_time >= next_time - half_step;
       if ((!step_due || !pacing_.paced()) && !parameters_.lockstep && callback_queue_.pending()) {
         const std::uint64_t resets_before = resets_;
         process_callbacks();
