@@ -306,8 +306,21 @@ TEST(FaultSignals, SameSceneAndCommandsRecordIdenticalData) {
 
 }  // namespace
 
+/// The children's logs, kept for the failure messages, removed at the end: tests leave nothing
+/// behind in /tmp.
+class RemoveScratchLogs : public testing::Environment {
+ public:
+  void TearDown() override {
+    for (const char* name : {"sigterm.log", "sigkill.log", "unwritable.log", "negative_start.log",
+                             "determinism_a.log", "determinism_b.log"}) {
+      std::remove(scratch(name).c_str());
+    }
+  }
+};
+
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
+  testing::AddGlobalTestEnvironment(new RemoveScratchLogs);
   ros::init(argc, argv, "fault_signals_test");
   ros::NodeHandle node;
   return RUN_ALL_TESTS();

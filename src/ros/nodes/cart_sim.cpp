@@ -1,14 +1,53 @@
 // cart_sim: the simulator node (README.md, "ROS interface"). All the work is in CartSimNode.
 // Exit codes: 0 finished or interrupted, 1 step failure, 2 refused at start, 3 record failure,
 // 4 unexpected error (bag closed), 130 a second SIGINT/SIGTERM (bag left as <path>.active).
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
 #include <cstdio>
+#include <fstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <ros/ros.h>
 
 #include "birkhoff_cart/core/version.h"
 #include "birkhoff_cart/ros/cart_sim_node.h"
+
+namespace {
+
+// ~end_launch (README.md): a roslaunch that started this node with required="true" prints a red
+// "REQUIRED process has died!" block whenever the node ends, also after a clean finish. With
+// ~end_launch the node asks its parent roslaunch to shut down (SIGINT) and waits for roslaunch's
+// own SIGINT before it exits, so roslaunch is already shutting down and prints no error.
+void end_parent_launch() {
+  const pid_t parent = ::getppid();
+  std::string name;
+  std::ifstream("/proc/" + std::to_string(parent) + "/comm") >> name;
+  if (name != "roslaunch") return;
+  ::kill(parent, SIGINT);
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (!birkhoff_cart::shutdown_signal_received() && std::chrono::steady_clock::now() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
+
+int run_node(ros::NodeHandle& node_handle) {
+  try {
+    birkhoff_cart::CartSimNode node(node_handle, ros::NodeHandle("~"));
+    return node.run();
+  } catch (const birkhoff_cart::NodeStartupError& error) {
+    ROS_FATAL("cart_sim: %s", error.what());
+    return birkhoff_cart::CartSimNode::kExitStartupFailure;
+  } catch (const std::exception& error) {  // run() catches its own; this is construction or teardown
+    ROS_FATAL("cart_sim: unexpected error: %s", error.what());
+    return birkhoff_cart::CartSimNode::kExitInternalError;
+  }
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   if (birkhoff_cart::print_version_if_asked(argc, argv, "cart_sim")) return 0;
@@ -26,14 +65,12 @@ int main(int argc, char** argv) {
   // Outlives the node: when the last NodeHandle dies roscpp shuts down and drops later log output,
   // so the FATAL message below would be lost.
   ros::NodeHandle node_handle;
-  try {
-    birkhoff_cart::CartSimNode node(node_handle, ros::NodeHandle("~"));
-    return node.run();
-  } catch (const birkhoff_cart::NodeStartupError& error) {
-    ROS_FATAL("cart_sim: %s", error.what());
-    return birkhoff_cart::CartSimNode::kExitStartupFailure;
-  } catch (const std::exception& error) {  // run() catches its own; this is construction or teardown
-    ROS_FATAL("cart_sim: unexpected error: %s", error.what());
-    return birkhoff_cart::CartSimNode::kExitInternalError;
+  const int exit_code = run_node(node_handle);
+  bool end_launch = false;
+  ros::param::get("~end_launch", end_launch);
+  if (end_launch && exit_code == birkhoff_cart::CartSimNode::kExitFinished &&
+      !birkhoff_cart::shutdown_signal_received()) {
+    end_parent_launch();
   }
+  return exit_code;
 }
