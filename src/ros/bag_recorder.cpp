@@ -4,7 +4,6 @@
 #include <sys/statvfs.h>
 
 #include <cerrno>
-#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
@@ -89,12 +88,8 @@ void BagRecorder::throw_if_unusable() const {
 void BagRecorder::write_queued() {
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {
-    if (queued_ == 0) {
-      if (!open_) return;  // closed and drained
-      // Drained: sleep until a batch of kWakeBatch messages is queued, the bag closes, or 50 ms.
-      slot_filled_.wait_for(lock, std::chrono::milliseconds(50), [this] { return queued_ >= kWakeBatch || !open_; });
-      continue;
-    }
+    slot_filled_.wait(lock, [this] { return queued_ > 0 || !open_; });
+    if (queued_ == 0) return;  // closed and drained
     Slot& slot = slots_[next_];
     if (!failure_) {
       // The slot is the writer's until released below: the loop fills only free slots.

@@ -65,8 +65,6 @@ class BagRecorder {
   using Message = std::variant<nav_msgs::Odometry, sensor_msgs::JointState, IntegrationError, std_msgs::Float64>;
   /// Slots of the ring between the time loop and the writer thread [messages].
   static constexpr std::size_t kQueueCapacity = 1024;
-  /// Queued messages that wake the writer thread [messages].
-  static constexpr std::size_t kWakeBatch = 64;
 
   /// Opens "<path>.active" for writing and starts the writer thread. Throws BagRecorderError when
   /// it cannot (missing or unwritable directory, empty path, ...) or, with `min_free_disk_space` >
@@ -95,11 +93,9 @@ class BagRecorder {
     } else {
       slot.message = message;
     }
-    // Wake the writer once per batch, not per message (a futex call each); it also looks every
-    // kWriterPeriod on its own, so a slow trickle of messages is written too.
-    const bool wake = ++queued_ == kWakeBatch;
+    ++queued_;
     lock.unlock();
-    if (wake) slot_filled_.notify_one();
+    slot_filled_.notify_one();
   }
 
   /// Drains the ring, flushes, closes and renames the bag to its final path. Idempotent. Throws
