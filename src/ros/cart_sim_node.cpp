@@ -16,6 +16,8 @@
 namespace birkhoff_cart {
 namespace {
 
+constexpr double kLastInstantLinger = 0.1;  // [s of wall time] after a run that ended well
+
 // What roscpp's own /clock subscription does, for a node that does not publish /clock.
 void hear_clock(const rosgraph_msgs::Clock::ConstPtr& clock) { ros::Time::setNow(clock->clock); }
 
@@ -283,6 +285,11 @@ int CartSimNode::run() {
     internal_error = error.what();
   }
 
+  if (!internal_error && !step_failure_ && !record_failure_ && !stop_requested()) {
+    // publish() only queues a message for roscpp's transport threads: give them a moment to send
+    // the last instant (subscribers lost the last /tf when the node left at once).
+    ros::WallDuration(kLastInstantLinger).sleep();
+  }
   if (step_failure_) {
     ROS_ERROR("cart_sim: step failed at t = %.9g s: %s", simulation_->state().time, step_failure_->c_str());
     outcome = "step failure: " + *step_failure_;
