@@ -7,6 +7,7 @@
 
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include <tf2_msgs/TFMessage.h>
 #include <rosgraph_msgs/Clock.h>
 #include <sensor_msgs/JointState.h>
 #include <tf2/utils.h>
@@ -47,10 +48,14 @@ TEST(NodeConsistency, OdomTfJointStatesAndCoreAgreeAtTheSameStamps) {
       "/clock", 1000, [&](const rosgraph_msgs::Clock::ConstPtr& message) { clocks.push_back(*message); });
   tf2_ros::Buffer buffer(ros::Duration(60.0));
   tf2_ros::TransformListener listener(buffer);
+  // The listener's /tf connection is made in the background like this one; unpausing before it
+  // exists lost the first transforms (seen once in a full run under load).
+  auto tf_probe = node.subscribe<tf2_msgs::TFMessage>(
+      "/tf", 10, [&](const tf2_msgs::TFMessage::ConstPtr&) {});
 
   ASSERT_TRUE(birkhoff_cart_test::wait_for(
       [&] { return odometry_subscriber.getNumPublishers() > 0 && joint_subscriber.getNumPublishers() > 0 &&
-                   clock_subscriber.getNumPublishers() > 0; },
+                   clock_subscriber.getNumPublishers() > 0 && tf_probe.getNumPublishers() > 0; },
       kWaitTimeout));
   ASSERT_TRUE(birkhoff_cart_test::set_paused("/cart_sim/pause", false));
 
