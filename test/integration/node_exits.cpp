@@ -101,6 +101,11 @@ TEST(NodeExits, SceneTimesBeyondRosTimeAreRefusedByName) {
   const std::size_t at = text.find(start);
   ASSERT_NE(at, std::string::npos) << "driven.yaml no longer starts with '  time: 0.0 '";
   text.replace(at, start.size(), "  time: 4294967290.0 ");  // 5 s before ROS time ends; the run lasts 60 s
+  // A step coarse enough for the scene loader's precision rule there (h >= 0.5 s), so the ROS-time
+  // limit is the one that refuses the run.
+  const std::size_t step_at = text.find("step_size: 1.0e-3");
+  ASSERT_NE(step_at, std::string::npos) << "driven.yaml no longer has 'step_size: 1.0e-3'";
+  text.replace(step_at, std::string("step_size: 1.0e-3").size(), "step_size: 1.0");
   const std::string scene = scratch("late_start.yaml");
   const std::string bag = scratch("late_start.bag");
   const std::string log = scratch("late_start.log");
