@@ -38,6 +38,12 @@ class CartBirkhoffianBase {
  public:
   static constexpr int kDimension = kBirkhoffianSize;
   static constexpr int kPassiveDimension = kPassiveSize;
+  /// No rate reads the arc length π1 (it is cyclic): implicit solves need not converge it.
+  static constexpr unsigned kCyclicMask = 1u << kArcLengthIndex;
+  /// g reads y only through θ, and θ̇ depends on z alone: two passive sweeps are exact.
+  static constexpr int kPassiveCouplingDepth = 1;
+  /// Both charts are linear in z (identity; diagonal scaling of p): remainders map through them.
+  static constexpr bool kDarbouxChartIsLinear = true;
   template <class S>
   using Vector = Eigen::Matrix<S, kDimension, 1>;
   template <class S>

@@ -11,7 +11,8 @@ namespace birkhoff_cart {
 struct StepStatistics {
   std::uint64_t steps = 0;                    ///< steps taken since start/reset
   std::uint64_t rhs_evaluations = 0;          ///< right-hand-side evaluations (incl. inside Newton)
-  std::uint64_t newton_iterations_total = 0;  ///< 0 for explicit methods
+  std::uint64_t passive_evaluations = 0;      ///< separate evaluations of the passive rates g (collocation members)
+  std::uint64_t newton_iterations_total = 0;  ///< implicit-solve iterations (Newton or fixed point); 0 for explicit methods
   std::uint64_t newton_iterations_last_step = 0;
 
   // The local error estimate (docs/accuracy.md): per step, the weighted max-norm

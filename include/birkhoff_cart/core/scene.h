@@ -68,6 +68,7 @@ struct IntegratorSettings {
   std::string birkhoffian_form = "autonomous";    ///< "autonomous" (z = (π1, χ, p1, p2), K = K₀) or "paper" (K = eᵗ J)
   int max_newton_iterations = 30;                 ///< per implicit step
   double newton_tolerance = 1e-14;                ///< on the scaled Newton update [-]
+  bool compensated_summation = true;              ///< Birkhoffian members: Kahan/TwoSum state update
 };
 
 /// What the simulation compares itself against, computed only when asked for.

@@ -10,6 +10,7 @@
 
 #include "birkhoff_cart/core/cart_birkhoffian.h"
 #include "birkhoff_cart/core/integrators/birkhoff_symplectic.h"
+#include "birkhoff_cart/core/integrators/carried_state.h"
 #include "birkhoff_cart/core/integrators/dopri5.h"
 #include "birkhoff_cart/core/integrators/implicit_midpoint.h"
 #include "birkhoff_cart/core/integrators/runge_kutta.h"
@@ -95,14 +96,80 @@ class CartStepperAdapter final : public CartStepper {
   std::string name_;
 };
 
+/// The Birkhoffian collocation members and compositions: the adapter carries the integrator's own
+/// state between steps (carried_state.h) — z and y with their compensated-summation remainders, χ
+/// and θ reduced modulo 2π with their turns apart, the stage-derivative memory — and uses it
+/// whenever the state handed in is the one it handed out; any other state (a reset, a state set by
+/// the caller) starts afresh from p = M(χ) ω. Transactional like CartStepperAdapter.
+template <class Stepper, class System>
+class CarriedCartStepperAdapter final : public CartStepper {
+ public:
+  CarriedCartStepperAdapter(const Stepper& stepper, const CartModel& model, const EffectSet& effects)
+      : stepper_(stepper), system_(model, effects), name_(Stepper::name()) {}
+
+  const std::string& name() const override { return name_; }
+  int order() const override { return Stepper::kOrder; }
+  bool symmetric() const override { return Stepper::kSymmetric; }
+
+  void step(CartState& state, double step_size, StepStatistics& statistics) override {
+    require_valid_step_size(step_size);
+    const double time = state.time;  // tₖ [s]
+    system_.begin_step(time);
+    CarriedCartState<System> trial = carried_;
+    if (!trial.continues(state)) trial.start_from(system_, state);
+    StepStatistics counted = statistics;
+    counted.newton_iterations_last_step = 0;
+    try {
+      stepper_.advance_compensated(system_, trial.point, trial.memory, time, step_size, counted);
+    } catch (const StepError& error) {
+      throw StepError(name_ + ": " + error.what());
+    }
+    for (int i = 0; i < kBirkhoffianSize; ++i) {
+      if (!std::isfinite(trial.point.z(i))) {
+        throw_non_finite(name_, time, step_size, kBirkhoffianNames[i], trial.point.z(i));
+      }
+    }
+    for (int i = 0; i < kPassiveSize; ++i) {
+      if (!std::isfinite(trial.point.y(i))) throw_non_finite(name_, time, step_size, kPassiveNames[i], trial.point.y(i));
+    }
+    trial.reduce_angles();
+    const CartState next = trial.output(system_, time + step_size);
+    if (!std::isfinite(next.forward_speed)) {
+      throw_non_finite(name_, time, step_size, "forward_speed omega1 (singular mass matrix?)", next.forward_speed);
+    }
+    if (!std::isfinite(next.steering_rate)) {
+      throw_non_finite(name_, time, step_size, "steering_rate omega2 (singular mass matrix?)", next.steering_rate);
+    }
+    ++counted.steps;
+    state = next;
+    statistics = counted;
+    carried_ = trial;
+  }
+
+ private:
+  Stepper stepper_;
+  System system_;
+  std::string name_;
+  CarriedCartState<System> carried_;
+};
+
+template <class Stepper, class System>
+std::unique_ptr<CartStepper> make_adapter(const Stepper& stepper, const CartModel& model, const EffectSet& effects) {
+  if constexpr (kCarriesState<Stepper, System>) {
+    return std::make_unique<CarriedCartStepperAdapter<Stepper, System>>(stepper, model, effects);
+  } else {
+    return std::make_unique<CartStepperAdapter<Stepper, System>>(stepper, model, effects);
+  }
+}
+
 template <class Stepper>
 std::unique_ptr<CartStepper> wrap(const Stepper& stepper, const IntegratorSettings& settings, const CartModel& model,
                                   const EffectSet& effects) {
   if (settings.birkhoffian_form == "autonomous") {
-    return std::make_unique<CartStepperAdapter<Stepper, CartAutonomousBirkhoffian>>(stepper, model, effects);
+    return make_adapter<Stepper, CartAutonomousBirkhoffian>(stepper, model, effects);
   }
   if (settings.birkhoffian_form == "paper") {
-    return std::make_unique<CartStepperAdapter<Stepper, CartPaperBirkhoffian>>(stepper, model, effects);
+    return make_adapter<Stepper, CartPaperBirkhoffian>(stepper, model, effects);
   }
   throw std::invalid_argument("unknown birkhoffian_form '" + settings.birkhoffian_form +
                               "' (known: autonomous, paper)");
@@ -116,7 +183,12 @@ std::string known_names() {
 
 }  // namespace
 
-std::vector<std::string> integrator_names() { return {"birkhoff2", "birkhoff4", "rk2", "rk4", "dopri5", "midpoint"}; }
+std::vector<std::string> integrator_names() {
+  return {"birkhoff2",          "birkhoff4",          "rk2",
+          "rk4",                "dopri5",             "midpoint",
+          "birkhoff_gauss4",    "birkhoff_gauss6",    "birkhoff_gauss8",
+          "birkhoff4_suzuki",   "birkhoff6_kahan_li", "birkhoff8_kahan_li"};
+}
 
 std::unique_ptr<CartStepper> make_cart_stepper(const IntegratorSettings& settings, const CartModel& model,
                                                const EffectSet& effects) {
@@ -132,8 +204,23 @@ std::unique_ptr<CartStepper> make_cart_stepper(const IntegratorSettings& setting
   newton.tolerance = settings.newton_tolerance;
   newton.max_iterations = settings.max_newton_iterations;
   const std::string& name = settings.name;
-  if (name == "birkhoff2") return wrap(BirkhoffSymplectic2(newton), settings, model, effects);
-  if (name == "birkhoff4") return wrap(BirkhoffSymplectic4(newton), settings, model, effects);
+  CollocationSettings collocation;
+  collocation.max_iterations = settings.max_newton_iterations;
+  collocation.compensated = settings.compensated_summation;
+  if (name == "birkhoff2") return wrap(GaussCollocation<1>(collocation), settings, model, effects);
+  if (name == "birkhoff4") return wrap(BirkhoffComposition<TripleJumpWeights>(collocation), settings, model, effects);
+  if (name == "birkhoff_gauss4") return wrap(GaussCollocation<2>(collocation), settings, model, effects);
+  if (name == "birkhoff_gauss6") return wrap(GaussCollocation<3>(collocation), settings, model, effects);
+  if (name == "birkhoff_gauss8") return wrap(GaussCollocation<4>(collocation), settings, model, effects);
+  if (name == "birkhoff4_suzuki") {
+    return wrap(BirkhoffComposition<SuzukiFiveWeights>(collocation), settings, model, effects);
+  }
+  if (name == "birkhoff6_kahan_li") {
+    return wrap(BirkhoffComposition<KahanLiSixWeights>(collocation), settings, model, effects);
+  }
+  if (name == "birkhoff8_kahan_li") {
+    return wrap(BirkhoffComposition<KahanLiEightWeights>(collocation), settings, model, effects);
+  }
   if (name == "rk2") return wrap(HeunRungeKutta2(), settings, model, effects);
   if (name == "rk4") return wrap(ClassicalRungeKutta4(), settings, model, effects);
   if (name == "dopri5") return wrap(DormandPrince5(settings.tolerance), settings, model, effects);

@@ -1,151 +1,115 @@
 // Generalized K(z,t)-symplectic difference schemes for Birkhoffian systems (Su's scheme, paper
-// eqs. (12)–(14); docs/birkhoffian.md §4, eqs. (B.12)–(B.17)).
+// eqs. (12)–(14); docs/birkhoffian.md §4, eqs. (B.12)–(B.17), and §7).
 //
 // birkhoff2 — the α mapping is the Darboux chart w = D(z, t) (D_zᵀ K₀ D_z = K) composed with the
-// Euler-centred (Cayley/Poincaré) generating-function map
-//     α(z̃, z) = ( K₀-type difference D(z̃, t⁺) − D(z, t),  mean ½[D(z̃, t⁺) + D(z, t)] ),
-// which satisfies α_*ᵀ J₄ₙ α_* = diag(K(z̃, t⁺), −K(z, t)) (eq. (B.13), checked in
-// k_symplectic_test.cpp). With the series (13) truncated after its first term ψ = τ H_w(w̄, t̄) the
-// scheme is the midpoint rule in the chart:
+// Euler-centred (Cayley/Poincaré) generating-function map; with the series (13) truncated after its
+// first term the scheme is the midpoint rule in the chart, i.e. one-stage Gauss collocation:
+// GaussCollocation<1> (gauss_collocation.h), solved by fixed-point iteration from extrapolated
+// starting values, with compensated summation when the caller carries remainders.
 //
-//     w⁽ᵏ⁾   = D(z⁽ᵏ⁾, tₖ)
-//     w⁽ᵏ⁺¹⁾ = w⁽ᵏ⁾ + h ẇ(w̄, t̄),   w̄ = ½(w⁽ᵏ⁾ + w⁽ᵏ⁺¹⁾), t̄ = tₖ + h/2     (solved by Newton)
-//     z⁽ᵏ⁺¹⁾ = D⁻¹(w⁽ᵏ⁺¹⁾, tₖ₊₁)
-//     y⁽ᵏ⁺¹⁾ = y⁽ᵏ⁾ + h g(D⁻¹(w̄, t̄), t̄)                                       (passive coordinates)
-//
-// For Λ = 0 the map z⁽ᵏ⁾ ↦ z⁽ᵏ⁺¹⁾ is K(z,t)-symplectic, Mᵀ K(z⁽ᵏ⁺¹⁾, tₖ₊₁) M = K(z⁽ᵏ⁾, tₖ) with
-// M = ∂z⁽ᵏ⁺¹⁾/∂z⁽ᵏ⁾, explicitly so by construction; it is symmetric (the adjoint of the step with
-// −h from tₖ₊₁ is itself), hence of order 2 with one term of the series.
-//
-// birkhoff4 — the symmetric triple jump (Yoshida 1990, Suzuki 1990) of birkhoff2 with
-// γ₁ = γ₃ = 1/(2 − 2^{1/3}), γ₂ = 1 − 2γ₁: a composition of K(z,t)-symplectic maps between
-// consecutive times is K(z,t)-symplectic, and a symmetric composition of a symmetric order-2 map
-// with these weights has order 4 (eq. (B.17)).
-//
-// The generic steppers never call system.begin_step(t) (the test systems have none): the caller
-// (the CartStepper registry) does, before every step; see docs/birkhoffian.md §6.
-// Statistics: each evaluation of ẇ counts one right-hand-side evaluation, Newton iterations are
-// counted per step; steps are counted by the caller.
+// Compositions Φ_h = Φ_{γ_m h} ∘ … ∘ Φ_{γ_1 h} of birkhoff2 (GNI §II.4, §V.3): a composition of
+// K(z,t)-symplectic maps between consecutive times is K(z,t)-symplectic, and a symmetric composition
+// of a symmetric order-2 map with these weights has the stated order (eq. (B.17)):
+//   birkhoff4           triple jump (Yoshida 1990, Suzuki 1990), 3 sub-steps, order 4;
+//   birkhoff4_suzuki    Suzuki's fractal 5-stage, γ = (p, p, 1 − 4p, p, p), p = 1/(4 − 4^{1/3}), order 4,
+//                       about 4× smaller error constant than the triple jump (GNI eq. (V.3.6));
+//   birkhoff6_kahan_li  Kahan & Li 1997 s9odr6a, 9 sub-steps, order 6 (GNI eq. (V.3.11));
+//   birkhoff8_kahan_li  Kahan & Li 1997 s17odr8a, 17 sub-steps, order 8 (GNI eq. (V.3.12)).
+// The sub-steps share one memory of stage derivatives, so each starts from a linear extrapolation of
+// the two sub-steps before it.
 #pragma once
 
-#include <algorithm>
+#include <array>
 #include <cmath>
-#include <limits>
-#include <string>
-#include <type_traits>
 
-#include "birkhoff_cart/core/birkhoffian_system.h"
-#include "birkhoff_cart/core/diagnostics.h"
-#include "birkhoff_cart/core/integrators/newton.h"
+#include "birkhoff_cart/core/integrators/gauss_collocation.h"
 
 namespace birkhoff_cart {
 
-/// birkhoff2: generalized K(z,t)-symplectic scheme of order 2 (Darboux chart + midpoint).
-class BirkhoffSymplectic2 {
- public:
-  static constexpr int kOrder = 2;
-  static constexpr bool kSymmetric = true;
-  static const char* name() { return "birkhoff2"; }
+/// birkhoff2: the one-stage member.
+using BirkhoffSymplectic2 = GaussCollocation<1>;
 
-  BirkhoffSymplectic2() = default;
-  explicit BirkhoffSymplectic2(const NewtonSettings& newton) : newton_(newton) {}
-  const NewtonSettings& newton_settings() const { return newton_; }
-
-  template <class System, class S>
-  void step(const System& system, StateVector<System, S>& z, PassiveVector<System, S>& y, double t, double h,
-            StepStatistics& statistics) const {
-    statistics.newton_iterations_last_step = 0;
-    advance(system, z, y, t, h, statistics);
-  }
-
-  /// One birkhoff2 step without resetting the per-step Newton counter (used by compositions).
-  template <class System, class S>
-  void advance(const System& system, StateVector<System, S>& z, PassiveVector<System, S>& y, double t, double h,
-               StepStatistics& statistics) const {
-    constexpr int n = System::kDimension;
-    using WVector = StateVector<System, S>;
-    const double t_mid = t + 0.5 * h;  // t̄ [s]
-    const double t_next = t + h;       // tₖ₊₁ [s]
-    const WVector w_start = system.to_darboux(z, S(t));  // w⁽ᵏ⁾ = D(z⁽ᵏ⁾, tₖ)
-
-    // F(w⁺) = w⁺ − w⁽ᵏ⁾ − h ẇ(½(w⁽ᵏ⁾ + w⁺), t̄); Jacobian I − (h/2) ∂ẇ/∂w by AD in newton.h.
-    const auto make_residual = [&system, &w_start, t_mid, h](auto cast) {
-      return [&system, &w_start, t_mid, h, cast](const auto& w_next) {
-        using T = typename std::decay_t<decltype(w_next)>::Scalar;
-        const Eigen::Matrix<T, n, 1> w_k = cast.template apply<T>(w_start);
-        const Eigen::Matrix<T, n, 1> w_mid = T(0.5) * (w_k + w_next);
-        return Eigen::Matrix<T, n, 1>(w_next - w_k - T(h) * system.darboux_rates(w_mid, T(t_mid)));
-      };
-    };
-    // Predictor: w⁺ ← w⁽ᵏ⁾ + h ẇ(w⁽ᵏ⁾, tₖ) (explicit Euler).
-    WVector w_next = w_start + S(h) * system.darboux_rates(w_start, S(t));
-    ++statistics.rhs_evaluations;
-    solve_newton<n>(make_residual, w_next, newton_, t, statistics);  // w⁽ᵏ⁺¹⁾ ← root of F
-
-    const WVector z_mid = system.from_darboux(WVector(S(0.5) * (w_start + w_next)), S(t_mid));  // z̄ = D⁻¹(w̄, t̄)
-    y = passive_midpoint(system, z_mid, y, t_mid, h, statistics);  // y⁽ᵏ⁺¹⁾ ← y⁽ᵏ⁾ + h g(z̄, ȳ, t̄)
-    z = system.from_darboux(w_next, S(t_next));                    // z⁽ᵏ⁺¹⁾ ← D⁻¹(w⁽ᵏ⁺¹⁾, tₖ₊₁)
-  }
-
-  /// Midpoint rule for the passive coordinates, y⁺ = y + h g(z̄, ½(y + y⁺), t̄), by fixed-point
-  /// sweeps. For the cart, g is triangular in y (θ̇ depends on z only, the rest on z and θ), so
-  /// the second sweep is exact and the third confirms it; a system whose g does not read y
-  /// converges in one sweep (plus the confirming one). Throws StepError if 50 sweeps do not settle.
-  template <class System, class S>
-  static PassiveVector<System, S> passive_midpoint(const System& system, const StateVector<System, S>& z_mid,
-                                                   const PassiveVector<System, S>& y, double t_mid, double h,
-                                                   StepStatistics& statistics) {
-    using YVector = PassiveVector<System, S>;
-    if constexpr (System::kPassiveDimension == 0) return y;
-    YVector y_next = y;
-    constexpr int kMaxSweeps = 50;
-    for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
-      const YVector y_mid = S(0.5) * (y + y_next);
-      // y⁺ ← y + h g(z̄, ½(y + y⁺), t̄)
-      const YVector updated = y + S(h) * passive_coordinate_rates(system, z_mid, y_mid, S(t_mid));
-      ++statistics.rhs_evaluations;
-      const bool settled = (values_of(updated) - values_of(y_next)).cwiseAbs().maxCoeff() <=
-                           4.0 * std::numeric_limits<double>::epsilon() *
-                               std::max(1.0, values_of(updated).cwiseAbs().maxCoeff());
-      y_next = updated;
-      if (sweep > 0 && settled) return y_next;  // ≥ 2 sweeps: derivative parts settled too
-    }
-    throw StepError("birkhoff2: the passive coordinates' midpoint sweeps did not settle at t = " +
-                    std::to_string(t_mid) + " s");
-  }
-
- private:
-  NewtonSettings newton_;
-};
-
-/// birkhoff4: symmetric triple-jump composition of birkhoff2 (order 4, K(z,t)-symplectic).
-class BirkhoffSymplectic4 {
- public:
+/// Weights of the symmetric compositions (γ₁ … γ_m, Σγ = 1).
+struct TripleJumpWeights {
+  static constexpr int kSubsteps = 3;
   static constexpr int kOrder = 4;
-  static constexpr bool kSymmetric = true;
   static const char* name() { return "birkhoff4"; }
+  static std::array<double, kSubsteps> weights() {
+    const double outer = 1.0 / (2.0 - std::cbrt(2.0));  // γ₁ = γ₃ ≈ 1.3512
+    return {outer, 1.0 - 2.0 * outer, outer};
+  }
+};
+struct SuzukiFiveWeights {
+  static constexpr int kSubsteps = 5;
+  static constexpr int kOrder = 4;
+  static const char* name() { return "birkhoff4_suzuki"; }
+  static std::array<double, kSubsteps> weights() {
+    const double p = 1.0 / (4.0 - std::cbrt(4.0));  // ≈ 0.41449
+    return {p, p, 1.0 - 4.0 * p, p, p};
+  }
+};
+struct KahanLiSixWeights {
+  static constexpr int kSubsteps = 9;
+  static constexpr int kOrder = 6;
+  static const char* name() { return "birkhoff6_kahan_li"; }
+  static std::array<double, kSubsteps> weights() {
+    constexpr double g1 = 0.39216144400731413927925056, g2 = 0.33259913678935943859974864,
+                     g3 = -0.70624617255763935980996482, g4 = 0.08221359629355080023149045,
+                     g5 = 0.79854399093482996339895035;
+    return {g1, g2, g3, g4, g5, g4, g3, g2, g1};
+  }
+};
+struct KahanLiEightWeights {
+  static constexpr int kSubsteps = 17;
+  static constexpr int kOrder = 8;
+  static const char* name() { return "birkhoff8_kahan_li"; }
+  static std::array<double, kSubsteps> weights() {
+    constexpr double g1 = 0.13020248308889008087881763, g2 = 0.56116298177510838456196441,
+                     g3 = -0.38947496264484728640807860, g4 = 0.15884190655515560089621075,
+                     g5 = -0.39590389413323757733623154, g6 = 0.18453964097831570709183254,
+                     g7 = 0.25837438768632204729397911, g8 = 0.29501172360931029887096624,
+                     g9 = -0.60550853383003451169892108;
+    return {g1, g2, g3, g4, g5, g6, g7, g8, g9, g8, g7, g6, g5, g4, g3, g2, g1};
+  }
+};
 
-  BirkhoffSymplectic4() = default;
-  explicit BirkhoffSymplectic4(const NewtonSettings& newton) : base_(newton) {}
-  const NewtonSettings& newton_settings() const { return base_.newton_settings(); }
+/// Symmetric composition of birkhoff2 with the given weights.
+template <class Weights>
+class BirkhoffComposition {
+ public:
+  static constexpr int kOrder = Weights::kOrder;
+  static constexpr bool kSymmetric = true;
+  static const char* name() { return Weights::name(); }
 
-  /// γ₁ = γ₃ = 1/(2 − 2^{1/3}) ≈ 1.3512, γ₂ = 1 − 2γ₁ ≈ −1.7024 (eq. (B.17)).
-  static double outer_weight() { return 1.0 / (2.0 - std::cbrt(2.0)); }
-  static double inner_weight() { return 1.0 - 2.0 * outer_weight(); }
+  BirkhoffComposition() = default;
+  explicit BirkhoffComposition(const NewtonSettings& newton) : base_(newton) {}
+  explicit BirkhoffComposition(const CollocationSettings& settings) : base_(settings) {}
 
   template <class System, class S>
   void step(const System& system, StateVector<System, S>& z, PassiveVector<System, S>& y, double t, double h,
             StepStatistics& statistics) const {
     statistics.newton_iterations_last_step = 0;
-    const double h1 = outer_weight() * h;  // γ₁ h [s]
-    const double h2 = inner_weight() * h;  // γ₂ h [s]
-    base_.advance(system, z, y, t, h1, statistics);            // z ← Φ_{γ₁h}(z) from tₖ
-    base_.advance(system, z, y, t + h1, h2, statistics);       // z ← Φ_{γ₂h}(z) from tₖ + γ₁h
-    base_.advance(system, z, y, t + h1 + h2, h1, statistics);  // z ← Φ_{γ₁h}(z) from tₖ + (γ₁+γ₂)h
+    double time = t;  // start of the current sub-step [s]
+    for (double gamma : Weights::weights()) {
+      base_.advance(system, z, y, time, gamma * h, statistics);  // z ← Φ_{γh}(z) from `time`
+      time += gamma * h;
+    }
+  }
+
+  template <class System>
+  void advance_compensated(const System& system, CompensatedPoint<System>& point, CollocationMemory<System>& memory,
+                           double t, double h, StepStatistics& statistics) const {
+    double time = t;
+    for (double gamma : Weights::weights()) {
+      base_.advance_compensated(system, point, memory, time, gamma * h, statistics);
+      time += gamma * h;
+    }
   }
 
  private:
-  BirkhoffSymplectic2 base_;
+  GaussCollocation<1> base_;
 };
+
+using BirkhoffSymplectic4 = BirkhoffComposition<TripleJumpWeights>;
 
 }  // namespace birkhoff_cart

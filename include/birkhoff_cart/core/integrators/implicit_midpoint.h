@@ -3,7 +3,7 @@
 //
 //   z⁽ᵏ⁺¹⁾ = z⁽ᵏ⁾ + h f(z̄, tₖ + h/2),   z̄ = (z⁽ᵏ⁾ + z⁽ᵏ⁺¹⁾)/2,   f(z, t) = K(z,t)⁻¹ (∇B + ∂R/∂t + Λ),
 //   y⁽ᵏ⁺¹⁾ = y⁽ᵏ⁾ + h g(z̄, ȳ, tₖ + h/2), ȳ = (y⁽ᵏ⁾ + y⁽ᵏ⁺¹⁾)/2   (passive coordinates at the midpoint,
-//            by the same fixed-point sweeps as birkhoff2: BirkhoffSymplectic2::passive_midpoint),
+//            by fixed-point sweeps: passive_midpoint_sweeps below),
 //
 // solved for z⁽ᵏ⁺¹⁾ by Newton's method with the AD Jacobian I − (h/2) ∂f/∂z(z̄) (newton.h), from the
 // explicit Euler predictor. Order 2, symmetric (self-adjoint).
@@ -25,11 +25,42 @@
 
 #include "birkhoff_cart/core/birkhoffian_system.h"
 #include "birkhoff_cart/core/diagnostics.h"
-#include "birkhoff_cart/core/integrators/birkhoff_symplectic.h"
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "birkhoff_cart/core/integrators/cart_stepper.h"
 #include "birkhoff_cart/core/integrators/error_estimate.h"
 #include "birkhoff_cart/core/integrators/newton.h"
 
 namespace birkhoff_cart {
+
+/// Midpoint rule for the passive coordinates, y⁺ = y + h g(z̄, ½(y + y⁺), t̄), by fixed-point
+/// sweeps. For the cart, g is triangular in y (θ̇ depends on z only, the rest on z and θ), so
+/// the second sweep is exact and the third confirms it; a system whose g does not read y
+/// converges in one sweep (plus the confirming one). Throws StepError if 50 sweeps do not settle.
+template <class System, class S>
+PassiveVector<System, S> passive_midpoint_sweeps(const System& system, const StateVector<System, S>& z_mid,
+                                                 const PassiveVector<System, S>& y, double t_mid, double h,
+                                                 StepStatistics& statistics) {
+  using YVector = PassiveVector<System, S>;
+  if constexpr (System::kPassiveDimension == 0) return y;
+  YVector y_next = y;
+  constexpr int kMaxSweeps = 50;
+  for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
+    const YVector y_mid = S(0.5) * (y + y_next);
+    // y⁺ ← y + h g(z̄, ½(y + y⁺), t̄)
+    const YVector updated = y + S(h) * passive_coordinate_rates(system, z_mid, y_mid, S(t_mid));
+    ++statistics.passive_evaluations;
+    const bool settled = (values_of(updated) - values_of(y_next)).cwiseAbs().maxCoeff() <=
+                         4.0 * std::numeric_limits<double>::epsilon() *
+                             std::max(1.0, values_of(updated).cwiseAbs().maxCoeff());
+    y_next = updated;
+    if (sweep > 0 && settled) return y_next;  // ≥ 2 sweeps: derivative parts settled too
+  }
+  throw StepError("midpoint: the passive coordinates' sweeps did not settle at t = " + std::to_string(t_mid) + " s");
+}
 
 class ImplicitMidpoint {
  public:
@@ -72,7 +103,7 @@ class ImplicitMidpoint {
                                                                         PassiveVector<System, S>::Zero()));
     // z̄ ← (z⁽ᵏ⁾ + z⁽ᵏ⁺¹⁾)/2;  y⁽ᵏ⁺¹⁾ ← y⁽ᵏ⁾ + h g(z̄, ȳ, tₖ + h/2)
     const StateVector<System, S> z_mid = S(0.5) * (z_start + z);
-    y = BirkhoffSymplectic2::passive_midpoint(system, z_mid, y, mid_time, h, statistics);
+    y = passive_midpoint_sweeps(system, z_mid, y, mid_time, h, statistics);
   }
 
  private:

@@ -1,0 +1,92 @@
+// What the Birkhoffian collocation members carry from one step to the next (docs/birkhoffian.md §7.4):
+// the point (z, y) with its compensated-summation remainders, the steering angle χ and heading θ
+// reduced to (−π, π] with whole turns kept apart (the cart's rates are 2π-periodic in both, so the
+// ulp of χ no longer grows with the turns: at χ ≈ 2262 rad it was 4.5e-13 rad), and the memory of
+// stage derivatives for starting values.
+#pragma once
+
+#include <cmath>
+#include <type_traits>
+#include <utility>
+
+#include "birkhoff_cart/core/cart_birkhoffian.h"
+#include "birkhoff_cart/core/integrators/gauss_collocation.h"
+#include "birkhoff_cart/core/state.h"
+
+namespace birkhoff_cart {
+
+/// 2π = kTwoPiHigh + kTwoPiLow to about 1e-32 rad.
+constexpr double kTwoPiHigh = 6.283185307179586;       // [rad]
+constexpr double kTwoPiLow = 2.4492935982947064e-16;   // [rad]
+
+/// Steppers with advance_compensated(system, CompensatedPoint&, CollocationMemory&, t, h, statistics).
+template <class Stepper, class System, class = void>
+struct CarriesStateTrait : std::false_type {};
+template <class Stepper, class System>
+struct CarriesStateTrait<Stepper, System,
+                         std::void_t<decltype(std::declval<const Stepper&>().advance_compensated(
+                             std::declval<const System&>(), std::declval<CompensatedPoint<System>&>(),
+                             std::declval<CollocationMemory<System>&>(), 0.0, 0.0, std::declval<StepStatistics&>()))>>
+    : std::true_type {};
+template <class Stepper, class System>
+constexpr bool kCarriesState = CarriesStateTrait<Stepper, System>::value;
+
+/// Reduces `angle` [rad] (with its remainder [rad]) into (−π, π], adding the removed turns to `turns`.
+inline void reduce_angle(double& angle, double& remainder, double& turns) {
+  const double k = std::nearbyint(angle / kTwoPiHigh);
+  if (k == 0.0) return;
+  angle = std::fma(-k, kTwoPiHigh, angle);  // one rounding; the exact result is near a small number
+  remainder -= k * kTwoPiLow;
+  turns += k;
+}
+
+template <class System>
+struct CarriedCartState {
+  bool valid = false;
+  CompensatedPoint<System> point;
+  CollocationMemory<System> memory;
+  double steering_turns = 0.0;  ///< whole turns removed from χ [-]
+  double heading_turns = 0.0;   ///< whole turns removed from θ [-]
+  CartState last_output;        ///< what the adapter last handed out
+
+  /// Is `state` exactly the state this carried state produced (every field, bit for bit)?
+  bool continues(const CartState& state) const {
+    if (!valid) return false;
+    const CartState& a = state;
+    const CartState& b = last_output;
+    return a.time == b.time && a.x == b.x && a.y == b.y && a.heading == b.heading &&
+           a.steering_angle == b.steering_angle && a.wheel_spin_angle == b.wheel_spin_angle &&
+           a.arc_length == b.arc_length && a.forward_speed == b.forward_speed && a.steering_rate == b.steering_rate &&
+           a.applied_work == b.applied_work && a.steering_impulse == b.steering_impulse;
+  }
+
+  /// Starts afresh from a cart state: p = M(χ) ω, no remainders, no memory.
+  void start_from(const System& system, const CartState& state) {
+    const CartBirkhoffianPoint fresh = system.to_birkhoffian(state);
+    point.z = fresh.z;
+    point.y = fresh.y;
+    point.z_remainder.setZero();
+    point.y_remainder.setZero();
+    memory.clear();
+    steering_turns = 0.0;
+    heading_turns = 0.0;
+    reduce_angles();
+    valid = true;
+  }
+
+  void reduce_angles() {
+    reduce_angle(point.z(kSteeringAngleIndex), point.z_remainder(kSteeringAngleIndex), steering_turns);
+    reduce_angle(point.y(kHeadingIndex), point.y_remainder(kHeadingIndex), heading_turns);
+  }
+
+  /// The cart state at time t [s], angles unwrapped again; remembered for continues().
+  CartState output(const System& system, double t) {
+    CartState state = system.to_cart_state(point.z, point.y, t);
+    state.steering_angle = point.z(kSteeringAngleIndex) + steering_turns * kTwoPiHigh;
+    state.heading = point.y(kHeadingIndex) + heading_turns * kTwoPiHigh;
+    last_output = state;
+    return state;
+  }
+};
+
+}  // namespace birkhoff_cart

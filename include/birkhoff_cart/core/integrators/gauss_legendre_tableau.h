@@ -1,0 +1,35 @@
+// Butcher tableaus of the s-stage Gauss–Legendre collocation methods (order 2s), s = 1 … 4, and the
+// weights that extrapolate a previous step's stage derivatives to starting values (docs/birkhoffian.md
+// §7, eqs. (B.20)–(B.23)).
+//
+// The nodes cᵢ are the roots of the shifted Legendre polynomial P_s(2c − 1), the weights
+// bⱼ = ∫₀¹ ℓⱼ(τ) dτ and aᵢⱼ = ∫₀^{cᵢ} ℓⱼ(τ) dτ with ℓⱼ the Lagrange basis on the nodes (Hairer, Nørsett,
+// Wanner I, §II.7; Hairer, Lubich, Wanner, GNI §II.1.3). They are computed once, in long double
+// (Newton on P_s, integrals by an exact Gauss rule), not typed in: test/unit/gauss_collocation_test.cpp
+// checks the simplifying conditions B(2s), C(s), D(s) that define the method.
+#pragma once
+
+#include <array>
+
+namespace birkhoff_cart {
+
+constexpr int kMaxGaussStages = 4;
+
+/// The s-stage Gauss–Legendre tableau (entries beyond s are zero).
+struct GaussLegendreTableau {
+  int stages = 0;                                                  ///< s [-]
+  std::array<double, kMaxGaussStages> nodes{};                     ///< cᵢ [-]
+  std::array<double, kMaxGaussStages> weights{};                   ///< bⱼ [-]
+  std::array<std::array<double, kMaxGaussStages>, kMaxGaussStages> coefficients{};  ///< aᵢⱼ [-]
+};
+
+/// The tableau with `stages` = 1 … 4 stages; throws std::invalid_argument otherwise.
+const GaussLegendreTableau& gauss_legendre_tableau(int stages);
+
+/// ∫_{from}^{to} ℓⱼ(τ) dτ for the Lagrange basis polynomials ℓⱼ, j < count, on the distinct abscissae
+/// `points` (any real numbers; used with stage times scaled by the new step to extrapolate stage
+/// derivatives, eq. (B.22)). Exact for the polynomial degree count − 1 ≤ 3.
+std::array<double, kMaxGaussStages> lagrange_basis_integrals(const std::array<double, kMaxGaussStages>& points,
+                                                             int count, double from, double to);
+
+}  // namespace birkhoff_cart

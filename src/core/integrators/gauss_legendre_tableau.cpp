@@ -1,0 +1,105 @@
+// Gauss–Legendre tableaus computed in long double (see the header).
+#include "birkhoff_cart/core/integrators/gauss_legendre_tableau.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace birkhoff_cart {
+namespace {
+
+using Real = long double;
+
+/// Legendre polynomial P_s(x) on [−1, 1] and its derivative, by the three-term recurrence.
+void legendre(int s, Real x, Real& value, Real& derivative) {
+  Real p_previous = 1.0L;
+  Real p = x;
+  if (s == 0) {
+    value = 1.0L;
+    derivative = 0.0L;
+    return;
+  }
+  for (int k = 2; k <= s; ++k) {
+    const Real p_next = ((2 * k - 1) * x * p - (k - 1) * p_previous) / k;
+    p_previous = p;
+    p = p_next;
+  }
+  value = p;
+  derivative = s * (x * p - p_previous) / (x * x - 1.0L);
+}
+
+/// Roots of P_s on (−1, 1), ascending, by Newton from Chebyshev-like guesses.
+std::array<Real, kMaxGaussStages> legendre_roots(int s) {
+  std::array<Real, kMaxGaussStages> roots{};
+  const Real pi = 3.141592653589793238462643383279502884L;
+  for (int i = 0; i < s; ++i) {
+    Real x = -std::cos(pi * (i + 0.75L) / (s + 0.5L));
+    for (int iteration = 0; iteration < 100; ++iteration) {
+      Real value = 0.0L;
+      Real derivative = 0.0L;
+      legendre(s, x, value, derivative);
+      const Real update = value / derivative;
+      x -= update;
+      if (std::fabs(update) < 1e-30L) break;
+    }
+    roots[i] = x;
+  }
+  return roots;
+}
+
+/// ℓⱼ(τ) on `points` (count of them).
+template <class Point>
+Real lagrange_basis(const std::array<Point, kMaxGaussStages>& points, int count, int j, Real tau) {
+  Real value = 1.0L;
+  for (int m = 0; m < count; ++m) {
+    if (m != j) value *= (tau - points[m]) / (static_cast<Real>(points[j]) - points[m]);
+  }
+  return value;
+}
+
+/// ∫_{from}^{to} ℓⱼ with the 2-point Gauss rule on [from, to]: exact for degree ≤ 3.
+template <class Point>
+Real integrate_basis(const std::array<Point, kMaxGaussStages>& points, int count, int j, Real from, Real to) {
+  const Real half = 0.5L * (to - from);
+  const Real mid = 0.5L * (to + from);
+  const Real offset = half / std::sqrt(3.0L);
+  return half * (lagrange_basis(points, count, j, mid - offset) + lagrange_basis(points, count, j, mid + offset));
+}
+
+GaussLegendreTableau compute_tableau(int s) {
+  GaussLegendreTableau tableau;
+  tableau.stages = s;
+  const std::array<Real, kMaxGaussStages> roots = legendre_roots(s);
+  std::array<Real, kMaxGaussStages> nodes{};
+  for (int i = 0; i < s; ++i) nodes[i] = 0.5L * (roots[i] + 1.0L);  // cᵢ = (xᵢ + 1)/2
+  for (int i = 0; i < s; ++i) {
+    tableau.nodes[i] = static_cast<double>(nodes[i]);
+    for (int j = 0; j < s; ++j) {
+      tableau.coefficients[i][j] = static_cast<double>(integrate_basis(nodes, s, j, 0.0L, nodes[i]));
+    }
+  }
+  for (int j = 0; j < s; ++j) tableau.weights[j] = static_cast<double>(integrate_basis(nodes, s, j, 0.0L, 1.0L));
+  return tableau;
+}
+
+}  // namespace
+
+const GaussLegendreTableau& gauss_legendre_tableau(int stages) {
+  static const std::array<GaussLegendreTableau, kMaxGaussStages> tableaus = {compute_tableau(1), compute_tableau(2),
+                                                                             compute_tableau(3), compute_tableau(4)};
+  if (stages < 1 || stages > kMaxGaussStages) {
+    throw std::invalid_argument("Gauss–Legendre collocation has 1 to 4 stages here, got " + std::to_string(stages));
+  }
+  return tableaus[stages - 1];
+}
+
+std::array<double, kMaxGaussStages> lagrange_basis_integrals(const std::array<double, kMaxGaussStages>& points,
+                                                             int count, double from, double to) {
+  std::array<double, kMaxGaussStages> integrals{};
+  for (int j = 0; j < count; ++j) {
+    integrals[j] = static_cast<double>(integrate_basis(points, count, j, from, to));
+  }
+  return integrals;
+}
+
+}  // namespace birkhoff_cart
