@@ -48,7 +48,7 @@ std::string paper_form_drift_warning(const Scene& scene) {
           << " s multiplies the momenta by about 1 + " << paper_form_momentum_change_per_step(scene)
           << " per step regardless of the motion: over " << scene.duration << " s they drift by " << 100.0 * growth
           << " % and the energy by at least twice that (10x on the jackknife whirl); use birkhoffian_form: "
-             "autonomous for long runs (docs/birkhoffian.md §9)";
+             "autonomous for long runs (docs/birkhoffian.md §10)";
   return message.str();
 }
 

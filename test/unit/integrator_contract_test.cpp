@@ -40,6 +40,20 @@ BirkhoffSymplectic2 make_generic() { return BirkhoffSymplectic2(NewtonSettings{}
 template <>
 BirkhoffSymplectic4 make_generic() { return BirkhoffSymplectic4(NewtonSettings{}); }
 template <>
+GaussCollocation<2> make_generic() { return GaussCollocation<2>(NewtonSettings{}); }
+template <>
+GaussCollocation<3> make_generic() { return GaussCollocation<3>(NewtonSettings{}); }
+template <>
+GaussCollocation<4> make_generic() { return GaussCollocation<4>(NewtonSettings{}); }
+template <>
+BirkhoffComposition<SuzukiFiveWeights> make_generic() { return BirkhoffComposition<SuzukiFiveWeights>(NewtonSettings{}); }
+template <>
+BirkhoffComposition<KahanLiSixWeights> make_generic() { return BirkhoffComposition<KahanLiSixWeights>(NewtonSettings{}); }
+template <>
+BirkhoffComposition<KahanLiEightWeights> make_generic() {
+  return BirkhoffComposition<KahanLiEightWeights>(NewtonSettings{});
+}
+template <>
 HeunRungeKutta2 make_generic() { return HeunRungeKutta2(); }
 template <>
 ClassicalRungeKutta4 make_generic() { return ClassicalRungeKutta4(); }
@@ -50,6 +64,34 @@ ImplicitMidpoint make_generic() { return ImplicitMidpoint(NewtonSettings{}); }
 
 template <class Stepper>
 constexpr bool kAdaptive = std::is_same<Stepper, DormandPrince5>::value;
+
+/// Observed order against nominal: within ±0.3 up to order 4. From order 6 on, the free cart's
+/// energy error and the forced cart's state error still fall faster than h^p over the step range
+/// that stays above the reference's 1e-13 floor (measured: gauss6 energy 6.57 then 6.05, Kahan–Li 8
+/// forced cart 9.0 then 8.3, energy 9.7 then 8.5): there the check is p − 0.3 ≤ observed ≤ p + 2.
+void expect_order(double observed, int nominal, const std::string& what) {
+  if (nominal <= 4) {
+    EXPECT_NEAR(observed, nominal, kOrderSlack) << what;
+  } else {
+    EXPECT_GE(observed, nominal - kOrderSlack) << what;
+    EXPECT_LE(observed, nominal + 2.0) << what;
+  }
+}
+
+/// Coarsest step counts for the order measurements (then ×2, ×4): the errors must stay in the
+/// asymptotic range and well above round-off and the reference's error at every level.
+enum class OrderProblem { kDampedOscillator, kForcedCart, kFreeCartEnergy };
+int base_steps(int order, OrderProblem problem) {
+  switch (problem) {
+    case OrderProblem::kDampedOscillator:
+      return order == 2 ? 100 : order == 4 ? 25 : order == 6 ? 8 : 4;
+    case OrderProblem::kForcedCart:
+      return order == 2 ? 100 : order == 4 ? 20 : order == 6 ? 8 : 3;
+    case OrderProblem::kFreeCartEnergy:
+      return order == 2 ? 200 : order == 4 ? 80 : order == 6 ? 40 : 30;
+  }
+  return 0;
+}
 
 /// Integrates the damped oscillator from t = 0 over `duration` [s] with n equal steps; returns the
 /// max-norm error of (q, p, y) against the exact solution.
@@ -116,8 +158,11 @@ class IntegratorContract : public ::testing::Test {
   const Stepper stepper_ = make_generic<Stepper>();
 };
 
-using AllSteppers = ::testing::Types<BirkhoffSymplectic2, BirkhoffSymplectic4, HeunRungeKutta2,
-                                     ClassicalRungeKutta4, DormandPrince5, ImplicitMidpoint>;
+using AllSteppers =
+    ::testing::Types<BirkhoffSymplectic2, BirkhoffSymplectic4, GaussCollocation<2>, GaussCollocation<3>,
+                     GaussCollocation<4>, BirkhoffComposition<SuzukiFiveWeights>,
+                     BirkhoffComposition<KahanLiSixWeights>, BirkhoffComposition<KahanLiEightWeights>,
+                     HeunRungeKutta2, ClassicalRungeKutta4, DormandPrince5, ImplicitMidpoint>;
 struct StepperNames {
   template <class Stepper>
   static std::string GetName(int) {
@@ -153,10 +198,10 @@ TYPED_TEST(IntegratorContract, ObservedOrderOnDampedOscillator) {
     }
     EXPECT_LT(errors.back(), 1e-10);
   } else {
-    const int base_steps = TypeParam::kOrder == 2 ? 100 : 25;
-    const double e1 = damped_oscillator_error(this->stepper_, kDuration, base_steps);
-    const double e2 = damped_oscillator_error(this->stepper_, kDuration, 2 * base_steps);
-    const double e3 = damped_oscillator_error(this->stepper_, kDuration, 4 * base_steps);
+    const int steps = base_steps(TypeParam::kOrder, OrderProblem::kDampedOscillator);
+    const double e1 = damped_oscillator_error(this->stepper_, kDuration, steps);
+    const double e2 = damped_oscillator_error(this->stepper_, kDuration, 2 * steps);
+    const double e3 = damped_oscillator_error(this->stepper_, kDuration, 4 * steps);
     const double order12 = std::log2(e1 / e2), order23 = std::log2(e2 / e3);
     std::printf("%s damped oscillator: errors %.3e %.3e %.3e, observed orders %.3f %.3f\n", TypeParam::name(), e1,
                 e2, e3, order12, order23);
@@ -185,10 +230,9 @@ TYPED_TEST(IntegratorContract, ObservedOrderOnForcedCartInBothRepresentations) {
       EXPECT_LT(errors[1], errors[0]);
       EXPECT_LT(errors[2], errors[1]);
     } else {
-      const int base_steps = TypeParam::kOrder == 2 ? 100 : 20;
       double errors[3];
       for (int level = 0; level < 3; ++level) {
-        const int steps = base_steps << level;
+        const int steps = base_steps(TypeParam::kOrder, OrderProblem::kForcedCart) << level;
         errors[level] = state_difference(run_cart(scene, settings_for(TypeParam::name(), form),
                                                   kDuration / steps, steps),
                                          reference);
@@ -196,8 +240,8 @@ TYPED_TEST(IntegratorContract, ObservedOrderOnForcedCartInBothRepresentations) {
       const double order12 = std::log2(errors[0] / errors[1]), order23 = std::log2(errors[1] / errors[2]);
       std::printf("%s cart (%s): errors %.3e %.3e %.3e, observed orders %.3f %.3f\n", TypeParam::name(),
                   form.c_str(), errors[0], errors[1], errors[2], order12, order23);
-      EXPECT_NEAR(order12, TypeParam::kOrder, kOrderSlack) << form;
-      EXPECT_NEAR(order23, TypeParam::kOrder, kOrderSlack) << form;
+      expect_order(order12, TypeParam::kOrder, form);
+      expect_order(order23, TypeParam::kOrder, form);
     }
   }
 }
@@ -250,10 +294,10 @@ TYPED_TEST(IntegratorContract, FreeCartInvariants) {
     EXPECT_LT(energy_errors[1], energy_errors[0]);
     EXPECT_LT(energy_errors[2], energy_errors[1]);
   } else {
-    const int base_steps = TypeParam::kOrder == 2 ? 200 : 80;
     double energy_errors[3], p2_errors[3];
     for (int level = 0; level < 3; ++level) {
-      run(settings_for(TypeParam::name()), base_steps << level, energy_errors[level], p2_errors[level]);
+      run(settings_for(TypeParam::name()), base_steps(TypeParam::kOrder, OrderProblem::kFreeCartEnergy) << level,
+          energy_errors[level], p2_errors[level]);
       EXPECT_LE(p2_errors[level], kLinearInvariantTolerance);
     }
     const double order12 = std::log2(energy_errors[0] / energy_errors[1]);
@@ -261,8 +305,8 @@ TYPED_TEST(IntegratorContract, FreeCartInvariants) {
     std::printf("%s free cart: max |dT*/T*| %.3e %.3e %.3e (orders %.3f %.3f), max |dp2/p2| %.3e\n",
                 TypeParam::name(), energy_errors[0], energy_errors[1], energy_errors[2], order12, order23,
                 p2_errors[2]);
-    EXPECT_NEAR(order12, TypeParam::kOrder, kOrderSlack);
-    EXPECT_NEAR(order23, TypeParam::kOrder, kOrderSlack);
+    expect_order(order12, TypeParam::kOrder, "free cart energy");
+    expect_order(order23, TypeParam::kOrder, "free cart energy");
   }
 }
 
@@ -349,9 +393,11 @@ TYPED_TEST(IntegratorContract, RejectsBadStepSizes) {
   EXPECT_EQ(state.time, scene.initial_state.time);
 }
 
-TEST(IntegratorRegistry, ListsTheSixIntegrators) {
+TEST(IntegratorRegistry, ListsEveryIntegrator) {
   EXPECT_EQ(integrator_names(),
-            (std::vector<std::string>{"birkhoff2", "birkhoff4", "rk2", "rk4", "dopri5", "midpoint"}));
+            (std::vector<std::string>{"birkhoff2", "birkhoff4", "rk2", "rk4", "dopri5", "midpoint", "birkhoff_gauss4",
+                                      "birkhoff_gauss6", "birkhoff_gauss8", "birkhoff4_suzuki", "birkhoff6_kahan_li",
+                                      "birkhoff8_kahan_li"}));
 }
 
 TEST(IntegratorRegistry, UnknownNameListsTheKnownOnes) {

@@ -131,7 +131,7 @@ const double kStepSizes[] = {1e-3, 1e-2, 0.1};  // h [s]
 const double kViolationStepSizes[] = {0.1, 0.2};  // h [s]
 
 template <class Stepper>
-void expect_k_symplectic_on_all_systems(const Stepper& stepper) {
+void expect_k_symplectic_on_all_systems(const Stepper& stepper, double tolerance = kSymplecticityTolerance) {
   StepStatistics statistics;
   double worst = 0.0;
   DampedOscillator oscillator;
@@ -146,9 +146,9 @@ void expect_k_symplectic_on_all_systems(const Stepper& stepper) {
       const double d1 = symplecticity_defect(stepper, oscillator, z, t, h, statistics);
       const double d2 = symplecticity_defect(stepper, cubic, z, t, h, statistics);
       const double d3 = symplecticity_defect(stepper, cubic_damped, z, t, h, statistics);
-      EXPECT_LE(d1, kSymplecticityTolerance) << "damped oscillator h = " << h;
-      EXPECT_LE(d2, kSymplecticityTolerance) << "cubic chart h = " << h;
-      EXPECT_LE(d3, kSymplecticityTolerance) << "cubic damped chart h = " << h;
+      EXPECT_LE(d1, tolerance) << "damped oscillator h = " << h;
+      EXPECT_LE(d2, tolerance) << "cubic chart h = " << h;
+      EXPECT_LE(d3, tolerance) << "cubic damped chart h = " << h;
       worst = std::max({worst, d1, d2, d3});
     }
   }
@@ -159,8 +159,8 @@ void expect_k_symplectic_on_all_systems(const Stepper& stepper) {
                                              statistics);
       const double db = symplecticity_defect(stepper, cart.birkhoffian_part<CartAutonomousBirkhoffian>(), z, 7.0,
                                              h, statistics);
-      EXPECT_LE(da, kSymplecticityTolerance) << "cart (a) h = " << h << " z = " << z.transpose();
-      EXPECT_LE(db, kSymplecticityTolerance) << "cart (b) h = " << h << " z = " << z.transpose();
+      EXPECT_LE(da, tolerance) << "cart (a) h = " << h << " z = " << z.transpose();
+      EXPECT_LE(db, tolerance) << "cart (b) h = " << h << " z = " << z.transpose();
       worst = std::max({worst, da, db});
     }
   }
@@ -175,6 +175,42 @@ TEST(KSymplecticity, Birkhoff2PreservesTheStructureOnEverySystem) {
 
 TEST(KSymplecticity, Birkhoff4PreservesTheStructureOnEverySystem) {
   expect_k_symplectic_on_all_systems(BirkhoffSymplectic4{});
+}
+
+TEST(KSymplecticity, GaussMembersPreserveTheStructureOnEverySystem) {
+  // Issue 11: a defect ≤ 1e-13 on the Λ = 0 systems.
+  expect_k_symplectic_on_all_systems(GaussCollocation<2>{}, 1e-13);
+  expect_k_symplectic_on_all_systems(GaussCollocation<3>{}, 1e-13);
+  expect_k_symplectic_on_all_systems(GaussCollocation<4>{}, 1e-13);
+}
+
+TEST(KSymplecticity, HigherCompositionsPreserveTheStructureOnEverySystem) {
+  expect_k_symplectic_on_all_systems(BirkhoffComposition<SuzukiFiveWeights>{}, 1e-13);
+  expect_k_symplectic_on_all_systems(BirkhoffComposition<KahanLiSixWeights>{}, 1e-13);
+  expect_k_symplectic_on_all_systems(BirkhoffComposition<KahanLiEightWeights>{}, 1e-13);
+}
+
+TEST(Symmetry, GaussMembersAndCompositionsReturnToTheStart) {
+  const CartFixture cart;
+  CartAutonomousBirkhoffian full_b(cart.model, cart.no_effects);
+  CartPaperBirkhoffian full_a(cart.model, cart.no_effects);
+  const Eigen::Vector2d z(0.8, -0.6);
+  for (double h : kStepSizes) {
+    auto check = [&](const auto& stepper) {
+      EXPECT_LE(symmetry_defect(stepper, DampedOscillator{}, z, 0.3, h), kSymmetryTolerance) << stepper.name();
+      EXPECT_LE(symmetry_defect(stepper, CubicChartOscillator{}, z, 0.3, h), kSymmetryTolerance) << stepper.name();
+      for (const Eigen::Vector4d& zc : cart.states) {
+        EXPECT_LE(symmetry_defect(stepper, full_a, zc, 7.0, h), kSymmetryTolerance) << stepper.name();
+        EXPECT_LE(symmetry_defect(stepper, full_b, zc, 7.0, h), kSymmetryTolerance) << stepper.name();
+      }
+    };
+    check(GaussCollocation<2>{});
+    check(GaussCollocation<3>{});
+    check(GaussCollocation<4>{});
+    check(BirkhoffComposition<SuzukiFiveWeights>{});
+    check(BirkhoffComposition<KahanLiSixWeights>{});
+    check(BirkhoffComposition<KahanLiEightWeights>{});
+  }
 }
 
 TEST(KSymplecticity, ClassicalRungeKutta4ViolatesIt) {

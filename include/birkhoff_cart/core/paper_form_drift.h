@@ -1,4 +1,4 @@
-// The paper's eᵗ form is not structure-preserving over long runs (docs/birkhoffian.md §9): a member
+// The paper's eᵗ form is not structure-preserving over long runs (docs/birkhoffian.md §10): a member
 // that steps in its Darboux chart w = (π1, χ, e^{t−tₑ} p) multiplies the momenta by a factor
 // 1 + δ(h) per step whatever the motion — for birkhoff2 δ = (1 + h/2)/(1 − h/2)·e^{−h} − 1
 // = h³/12 + O(h⁵) — so they grow like (1 + δ)^{t/h} ≈ exp(t h²/12). This module measures δ of the

@@ -100,7 +100,8 @@ class CartStepperAdapter final : public CartStepper {
 /// state between steps (carried_state.h) — z and y with their compensated-summation remainders, χ
 /// and θ reduced modulo 2π with their turns apart, the stage-derivative memory — and uses it
 /// whenever the state handed in is the one it handed out; any other state (a reset, a state set by
-/// the caller) starts afresh from p = M(χ) ω. Transactional like CartStepperAdapter.
+/// the caller) starts afresh from p = M(χ) ω. A failed step leaves the caller's state and statistics
+/// untouched and drops the carried state.
 template <class Stepper, class System>
 class CarriedCartStepperAdapter final : public CartStepper {
  public:
@@ -115,42 +116,43 @@ class CarriedCartStepperAdapter final : public CartStepper {
     require_valid_step_size(step_size);
     const double time = state.time;  // tₖ [s]
     system_.begin_step(time);
-    CarriedCartState<System> trial = carried_;
-    if (!trial.continues(state)) trial.start_from(system_, state);
+    if (!carried_.continues(state)) carried_.start_from(system_, state);
     StepStatistics counted = statistics;
     counted.newton_iterations_last_step = 0;
+    // On any failure the carried state is dropped (the next step starts afresh from the caller's
+    // unchanged state): cheaper than copying the Newton matrices every step, and as deterministic.
+    carried_.valid = false;
     try {
-      stepper_.advance_compensated(system_, trial.point, trial.memory, time, step_size, counted);
+      stepper_.advance_compensated(system_, carried_.point, carried_.memory, time, step_size, counted);
     } catch (const StepError& error) {
       throw StepError(name_ + ": " + error.what());
     }
+    const auto& point = carried_.point;
     for (int i = 0; i < kBirkhoffianSize; ++i) {
-      if (!std::isfinite(trial.point.z(i))) {
-        throw_non_finite(name_, time, step_size, kBirkhoffianNames[i], trial.point.z(i));
-      }
+      if (!std::isfinite(point.z(i))) throw_non_finite(name_, time, step_size, kBirkhoffianNames[i], point.z(i));
     }
     for (int i = 0; i < kPassiveSize; ++i) {
-      if (!std::isfinite(trial.point.y(i))) throw_non_finite(name_, time, step_size, kPassiveNames[i], trial.point.y(i));
+      if (!std::isfinite(point.y(i))) throw_non_finite(name_, time, step_size, kPassiveNames[i], point.y(i));
     }
-    trial.reduce_angles();
-    const CartState next = trial.output(system_, time + step_size);
+    carried_.reduce_angles();
+    const CartState next = carried_.output(system_, time + step_size);
     if (!std::isfinite(next.forward_speed)) {
       throw_non_finite(name_, time, step_size, "forward_speed omega1 (singular mass matrix?)", next.forward_speed);
     }
     if (!std::isfinite(next.steering_rate)) {
       throw_non_finite(name_, time, step_size, "steering_rate omega2 (singular mass matrix?)", next.steering_rate);
     }
+    carried_.valid = true;
     ++counted.steps;
     state = next;
     statistics = counted;
-    carried_ = trial;
   }
 
  private:
   Stepper stepper_;
   System system_;
   std::string name_;
-  CarriedCartState<System> carried_;
+  CarriedCartState<System, typename Stepper::template Memory<System>> carried_;
 };
 
 template <class Stepper, class System>

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace birkhoff_cart {
 namespace {
@@ -78,7 +79,32 @@ GaussLegendreTableau compute_tableau(int s) {
       tableau.coefficients[i][j] = static_cast<double>(integrate_basis(nodes, s, j, 0.0L, nodes[i]));
     }
   }
-  for (int j = 0; j < s; ++j) tableau.weights[j] = static_cast<double>(integrate_basis(nodes, s, j, 0.0L, 1.0L));
+  std::array<std::array<Real, kMaxGaussStages>, kMaxGaussStages> a{};
+  std::array<Real, kMaxGaussStages> b{};
+  for (int j = 0; j < s; ++j) {
+    b[j] = integrate_basis(nodes, s, j, 0.0L, 1.0L);
+    tableau.weights[j] = static_cast<double>(b[j]);
+    for (int i = 0; i < s; ++i) a[i][j] = integrate_basis(nodes, s, j, 0.0L, nodes[i]);
+  }
+  // d solves Aᵀ d = b (Gaussian elimination with partial pivoting, long double).
+  std::array<std::array<Real, kMaxGaussStages + 1>, kMaxGaussStages> system{};
+  for (int i = 0; i < s; ++i) {
+    for (int j = 0; j < s; ++j) system[i][j] = a[j][i];
+    system[i][s] = b[i];
+  }
+  for (int column = 0; column < s; ++column) {
+    int pivot = column;
+    for (int row = column + 1; row < s; ++row) {
+      if (std::fabs(system[row][column]) > std::fabs(system[pivot][column])) pivot = row;
+    }
+    std::swap(system[column], system[pivot]);
+    for (int row = 0; row < s; ++row) {
+      if (row == column) continue;
+      const Real factor = system[row][column] / system[column][column];
+      for (int k = column; k <= s; ++k) system[row][k] -= factor * system[column][k];
+    }
+  }
+  for (int i = 0; i < s; ++i) tableau.increment_weights[i] = static_cast<double>(system[i][s] / system[i][i]);
   return tableau;
 }
 
@@ -91,6 +117,13 @@ const GaussLegendreTableau& gauss_legendre_tableau(int stages) {
     throw std::invalid_argument("Gauss–Legendre collocation has 1 to 4 stages here, got " + std::to_string(stages));
   }
   return tableaus[stages - 1];
+}
+
+std::array<double, kMaxGaussStages> lagrange_basis_values(const std::array<double, kMaxGaussStages>& points, int count,
+                                                          double tau) {
+  std::array<double, kMaxGaussStages> values{};
+  for (int j = 0; j < count; ++j) values[j] = static_cast<double>(lagrange_basis(points, count, j, tau));
+  return values;
 }
 
 std::array<double, kMaxGaussStages> lagrange_basis_integrals(const std::array<double, kMaxGaussStages>& points,

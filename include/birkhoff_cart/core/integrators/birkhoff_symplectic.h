@@ -1,5 +1,5 @@
 // Generalized K(z,t)-symplectic difference schemes for Birkhoffian systems (Su's scheme, paper
-// eqs. (12)–(14); docs/birkhoffian.md §4, eqs. (B.12)–(B.17), and §7).
+// eqs. (12)–(14); docs/birkhoffian.md §4, eqs. (B.12)–(B.17), and §10).
 //
 // birkhoff2 — the α mapping is the Darboux chart w = D(z, t) (D_zᵀ K₀ D_z = K) composed with the
 // Euler-centred (Cayley/Poincaré) generating-function map; with the series (13) truncated after its
@@ -16,7 +16,7 @@
 //   birkhoff6_kahan_li  Kahan & Li 1997 s9odr6a, 9 sub-steps, order 6 (GNI eq. (V.3.11));
 //   birkhoff8_kahan_li  Kahan & Li 1997 s17odr8a, 17 sub-steps, order 8 (GNI eq. (V.3.12)).
 // The sub-steps share one memory of stage derivatives, so each starts from a linear extrapolation of
-// the two sub-steps before it.
+// the two sub-steps before it, and one Jacobian with a Newton matrix per distinct sub-step size.
 #pragma once
 
 #include <array>
@@ -80,6 +80,8 @@ class BirkhoffComposition {
   static constexpr int kOrder = Weights::kOrder;
   static constexpr bool kSymmetric = true;
   static const char* name() { return Weights::name(); }
+  template <class System>
+  using Memory = CollocationMemory<System, 1>;
 
   BirkhoffComposition() = default;
   explicit BirkhoffComposition(const NewtonSettings& newton) : base_(newton) {}
@@ -97,7 +99,7 @@ class BirkhoffComposition {
   }
 
   template <class System>
-  void advance_compensated(const System& system, CompensatedPoint<System>& point, CollocationMemory<System>& memory,
+  void advance_compensated(const System& system, CompensatedPoint<System>& point, CollocationMemory<System, 1>& memory,
                            double t, double h, StepStatistics& statistics) const {
     double time = t;
     for (double gamma : Weights::weights()) {

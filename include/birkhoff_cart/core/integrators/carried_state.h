@@ -1,4 +1,4 @@
-// What the Birkhoffian collocation members carry from one step to the next (docs/birkhoffian.md §7.4):
+// What the Birkhoffian collocation members carry from one step to the next (docs/birkhoffian.md §10.4):
 // the point (z, y) with its compensated-summation remainders, the steering angle χ and heading θ
 // reduced to (−π, π] with whole turns kept apart (the cart's rates are 2π-periodic in both, so the
 // ulp of χ no longer grows with the turns: at χ ≈ 2262 rad it was 4.5e-13 rad), and the memory of
@@ -26,7 +26,8 @@ template <class Stepper, class System>
 struct CarriesStateTrait<Stepper, System,
                          std::void_t<decltype(std::declval<const Stepper&>().advance_compensated(
                              std::declval<const System&>(), std::declval<CompensatedPoint<System>&>(),
-                             std::declval<CollocationMemory<System>&>(), 0.0, 0.0, std::declval<StepStatistics&>()))>>
+                             std::declval<typename Stepper::template Memory<System>&>(), 0.0, 0.0,
+                             std::declval<StepStatistics&>()))>>
     : std::true_type {};
 template <class Stepper, class System>
 constexpr bool kCarriesState = CarriesStateTrait<Stepper, System>::value;
@@ -40,21 +41,23 @@ inline void reduce_angle(double& angle, double& remainder, double& turns) {
   turns += k;
 }
 
-template <class System>
+template <class System, class Memory>
 struct CarriedCartState {
   bool valid = false;
   CompensatedPoint<System> point;
-  CollocationMemory<System> memory;
+  Memory memory;
   double steering_turns = 0.0;  ///< whole turns removed from χ [-]
   double heading_turns = 0.0;   ///< whole turns removed from θ [-]
   CartState last_output;        ///< what the adapter last handed out
 
-  /// Is `state` exactly the state this carried state produced (every field, bit for bit)?
+  /// Is `state` exactly the state this carried state produced (every field but the time, bit for
+  /// bit)? The time is left out: callers set t = t₀ + n·h themselves (simulation.cpp), which may
+  /// differ from tₖ + h by an ulp.
   bool continues(const CartState& state) const {
     if (!valid) return false;
     const CartState& a = state;
     const CartState& b = last_output;
-    return a.time == b.time && a.x == b.x && a.y == b.y && a.heading == b.heading &&
+    return a.x == b.x && a.y == b.y && a.heading == b.heading &&
            a.steering_angle == b.steering_angle && a.wheel_spin_angle == b.wheel_spin_angle &&
            a.arc_length == b.arc_length && a.forward_speed == b.forward_speed && a.steering_rate == b.steering_rate &&
            a.applied_work == b.applied_work && a.steering_impulse == b.steering_impulse;

@@ -1,6 +1,6 @@
 // Butcher tableaus of the s-stage Gauss–Legendre collocation methods (order 2s), s = 1 … 4, and the
 // weights that extrapolate a previous step's stage derivatives to starting values (docs/birkhoffian.md
-// §7, eqs. (B.20)–(B.23)).
+// §10, eqs. (B.30)–(B.33)).
 //
 // The nodes cᵢ are the roots of the shifted Legendre polynomial P_s(2c − 1), the weights
 // bⱼ = ∫₀¹ ℓⱼ(τ) dτ and aᵢⱼ = ∫₀^{cᵢ} ℓⱼ(τ) dτ with ℓⱼ the Lagrange basis on the nodes (Hairer, Nørsett,
@@ -21,14 +21,22 @@ struct GaussLegendreTableau {
   std::array<double, kMaxGaussStages> nodes{};                     ///< cᵢ [-]
   std::array<double, kMaxGaussStages> weights{};                   ///< bⱼ [-]
   std::array<std::array<double, kMaxGaussStages>, kMaxGaussStages> coefficients{};  ///< aᵢⱼ [-]
+  /// dᵢ = (bᵀA⁻¹)ᵢ: w⁺ = w + Σ dᵢ Zᵢ with the stage increments Zᵢ = Wᵢ − w = h Σⱼ aᵢⱼ Fⱼ, which needs no
+  /// evaluation of F at the converged stages (eq. (B.33); Hairer–Wanner II §IV.8) [-].
+  std::array<double, kMaxGaussStages> increment_weights{};
 };
 
 /// The tableau with `stages` = 1 … 4 stages; throws std::invalid_argument otherwise.
 const GaussLegendreTableau& gauss_legendre_tableau(int stages);
 
+/// ℓⱼ(τ) for the Lagrange basis on the distinct abscissae `points`, j < count (extrapolation of stage
+/// derivatives to the next step's stage times, eq. (B.32)).
+std::array<double, kMaxGaussStages> lagrange_basis_values(const std::array<double, kMaxGaussStages>& points, int count,
+                                                          double tau);
+
 /// ∫_{from}^{to} ℓⱼ(τ) dτ for the Lagrange basis polynomials ℓⱼ, j < count, on the distinct abscissae
 /// `points` (any real numbers; used with stage times scaled by the new step to extrapolate stage
-/// derivatives, eq. (B.22)). Exact for the polynomial degree count − 1 ≤ 3.
+/// derivatives, eq. (B.32)). Exact for the polynomial degree count − 1 ≤ 3.
 std::array<double, kMaxGaussStages> lagrange_basis_integrals(const std::array<double, kMaxGaussStages>& points,
                                                              int count, double from, double to);
 

@@ -1,0 +1,179 @@
+// Gauss–Legendre collocation and the carried state (docs/birkhoffian.md §9): the tableau's defining
+// conditions, compensated summation against a run without it, the steering angle kept reduced, the
+// stage solve's work, and the paper's eᵗ form.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <utility>
+#include <memory>
+#include <string>
+
+#include "birkhoff_cart/core/cart_model.h"
+#include "birkhoff_cart/core/effect_library.h"
+#include "birkhoff_cart/core/effects.h"
+#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/integrators/gauss_legendre_tableau.h"
+#include "birkhoff_cart/core/scene.h"
+
+namespace birkhoff_cart {
+namespace {
+
+Scene load(const std::string& name) {
+  return load_scene(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/" + name + ".yaml");
+}
+
+TEST(GaussLegendreTableau, SatisfiesTheSimplifyingConditionsOfOrderTwoS) {
+  // B(2s): Σ bᵢ cᵢ^{k−1} = 1/k, k ≤ 2s;  C(s): Σⱼ aᵢⱼ cⱼ^{k−1} = cᵢ^k/k, k ≤ s;
+  // D(s): Σᵢ bᵢ cᵢ^{k−1} aᵢⱼ = bⱼ(1 − cⱼ^k)/k, k ≤ s (Hairer–Nørsett–Wanner I, §II.7).
+  for (int s = 1; s <= kMaxGaussStages; ++s) {
+    const GaussLegendreTableau& tableau = gauss_legendre_tableau(s);
+    ASSERT_EQ(tableau.stages, s);
+    for (int k = 1; k <= 2 * s; ++k) {
+      double sum = 0.0;
+      for (int i = 0; i < s; ++i) sum += tableau.weights[i] * std::pow(tableau.nodes[i], k - 1);
+      EXPECT_NEAR(sum, 1.0 / k, 1e-15) << "B(2s), s = " << s << ", k = " << k;
+    }
+    for (int k = 1; k <= s; ++k) {
+      for (int i = 0; i < s; ++i) {
+        double sum = 0.0;
+        for (int j = 0; j < s; ++j) sum += tableau.coefficients[i][j] * std::pow(tableau.nodes[j], k - 1);
+        EXPECT_NEAR(sum, std::pow(tableau.nodes[i], k) / k, 1e-15) << "C(s), s = " << s;
+      }
+      for (int j = 0; j < s; ++j) {
+        double sum = 0.0;
+        for (int i = 0; i < s; ++i) {
+          sum += tableau.weights[i] * std::pow(tableau.nodes[i], k - 1) * tableau.coefficients[i][j];
+        }
+        EXPECT_NEAR(sum, tableau.weights[j] * (1.0 - std::pow(tableau.nodes[j], k)) / k, 1e-15) << "D(s), s = " << s;
+      }
+    }
+    // d = bᵀA⁻¹: Σᵢ dᵢ aᵢⱼ = bⱼ.
+    for (int j = 0; j < s; ++j) {
+      double sum = 0.0;
+      for (int i = 0; i < s; ++i) sum += tableau.increment_weights[i] * tableau.coefficients[i][j];
+      EXPECT_NEAR(sum, tableau.weights[j], 1e-14) << "d = bᵀA⁻¹, s = " << s;
+    }
+  }
+  EXPECT_DOUBLE_EQ(gauss_legendre_tableau(1).nodes[0], 0.5);
+  EXPECT_DOUBLE_EQ(gauss_legendre_tableau(1).increment_weights[0], 2.0);
+  EXPECT_THROW(gauss_legendre_tableau(5), std::invalid_argument);
+}
+
+/// Straight coasting (χ = θ = 0, no loads): every rate is constant, so any method is exact and the
+/// only error left is round-off in x and π1. Without compensation the same increment h·ω1 is
+/// added 10⁵ times with a biased rounding; with it x stays within an ulp or two of x₀ + n h ω1.
+double straight_coast_round_off(const std::string& integrator, bool compensated) {
+  const Scene scene = load("free_coast");
+  const CartModel model(scene.cart);
+  const EffectSet no_effects;
+  IntegratorSettings settings;
+  settings.name = integrator;
+  settings.step_size = 1e-3;
+  settings.compensated_summation = compensated;
+  std::unique_ptr<CartStepper> stepper = make_cart_stepper(settings, model, no_effects);
+  CartState state;
+  state.x = 0.3;                // [m]
+  state.forward_speed = 0.123;  // [m/s]
+  StepStatistics statistics;
+  constexpr int kSteps = 100000;
+  for (int k = 1; k <= kSteps; ++k) {
+    stepper->step(state, settings.step_size, statistics);
+    state.time = k * settings.step_size;
+  }
+  const long double exact = 0.3L + static_cast<long double>(kSteps) * 1e-3L * static_cast<long double>(0.123);
+  return static_cast<double>(std::fabs(static_cast<long double>(state.x) - exact));
+}
+
+TEST(CompensatedSummation, KeepsTheStraightCoastWithinAnUlpWhereThePlainSumDrifts) {
+  for (const std::string integrator : {"birkhoff2", "birkhoff_gauss6"}) {
+    const double with = straight_coast_round_off(integrator, true);
+    const double without = straight_coast_round_off(integrator, false);
+    std::printf("[ measured ] %s straight coast, 1e5 steps: |x − exact| %.3e m compensated, %.3e m plain\n",
+                integrator.c_str(), with, without);
+    EXPECT_LE(with, 4.0 * std::numeric_limits<double>::epsilon() * 12.6) << integrator;
+    EXPECT_GE(without, 20.0 * with + 1e-13) << integrator;
+  }
+}
+
+TEST(CarriedState, SteeringAngleStaysReducedAndTheReportedAngleUnwrapped) {
+  // jackknife_whirl turns χ through many whole turns; the reported χ is unwrapped (continuous).
+  const Scene scene = load("jackknife_whirl");
+  const CartModel model(scene.cart);
+  const EffectSet no_effects;
+  IntegratorSettings settings;
+  settings.name = "birkhoff_gauss4";
+  std::unique_ptr<CartStepper> stepper = make_cart_stepper(settings, model, no_effects);
+  CartState state = scene.initial_state;
+  StepStatistics statistics;
+  const double h = 0.02;  // [s]
+  double previous = state.steering_angle;
+  double largest_jump = 0.0;
+  for (int k = 1; k <= 5000; ++k) {
+    stepper->step(state, h, statistics);
+    state.time = k * h;
+    largest_jump = std::max(largest_jump, std::abs(state.steering_angle - previous));
+    previous = state.steering_angle;
+  }
+  EXPECT_GT(std::abs(state.steering_angle), 4.0 * M_PI);  // several turns
+  EXPECT_LT(largest_jump, 0.5);                           // no 2π jumps in the report
+}
+
+TEST(StageSolve, NeedsFewIterationsFromExtrapolatedStartingValues) {
+  // Issue 11 aims at about 4 iterations a step; measured 4.3 (birkhoff2), 6.2 (gauss6), 5.5 (gauss8) with
+  // the Jacobian kept across steps. Iteration counts are deterministic; the bound guards against a
+  // regression of the starting values (an explicit start needs 7–9 at these steps).
+  const Scene scene = load("jackknife_whirl");
+  const CartModel model(scene.cart);
+  const EffectSet no_effects;
+  for (const auto& [name, h] : {std::pair<const char*, double>{"birkhoff2", 0.005}, {"birkhoff_gauss6", 0.025},
+                                {"birkhoff_gauss8", 0.025}}) {
+    IntegratorSettings settings;
+    settings.name = name;
+    std::unique_ptr<CartStepper> stepper = make_cart_stepper(settings, model, no_effects);
+    CartState state = scene.initial_state;
+    StepStatistics statistics;
+    for (int k = 1; k <= 2000; ++k) {
+      stepper->step(state, h, statistics);
+      state.time = k * h;
+    }
+    const double per_step = static_cast<double>(statistics.newton_iterations_total) / statistics.steps;
+    std::printf("[ measured ] %s h = %g: %.2f iterations, %.2f rhs and %.2f passive evaluations per step\n", name, h,
+                per_step, static_cast<double>(statistics.rhs_evaluations) / statistics.steps,
+                static_cast<double>(statistics.passive_evaluations) / statistics.steps);
+    EXPECT_LE(per_step, 7.0) << name;
+    EXPECT_GE(per_step, 1.0) << name;
+  }
+}
+
+TEST(PaperForm, EveryBirkhoffianMemberSupportsIt) {
+  // The eᵗ form's chart is linear in z: every member runs it and agrees with the autonomous form to
+  // the method's accuracy on the forced cart.
+  const Scene scene = load("sine_steer_torque");
+  const CartModel model(scene.cart);
+  const EffectSet effects = build_effects(scene.effects, model);
+  for (const std::string name : {"birkhoff_gauss4", "birkhoff_gauss6", "birkhoff_gauss8", "birkhoff4_suzuki",
+                                 "birkhoff6_kahan_li", "birkhoff8_kahan_li"}) {
+    CartState results[2];
+    int index = 0;
+    for (const std::string form : {"autonomous", "paper"}) {
+      IntegratorSettings settings;
+      settings.name = name;
+      settings.birkhoffian_form = form;
+      std::unique_ptr<CartStepper> stepper = make_cart_stepper(settings, model, effects);
+      CartState state = scene.initial_state;
+      StepStatistics statistics;
+      for (int k = 1; k <= 100; ++k) {
+        stepper->step(state, 0.01, statistics);
+        state.time = k * 0.01;
+      }
+      results[index++] = state;
+    }
+    EXPECT_NEAR(results[0].x, results[1].x, 1e-7) << name;
+    EXPECT_NEAR(results[0].steering_angle, results[1].steering_angle, 1e-7) << name;
+  }
+}
+
+}  // namespace
+}  // namespace birkhoff_cart
