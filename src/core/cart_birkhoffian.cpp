@@ -1,13 +1,16 @@
 #include "birkhoff_cart/core/cart_birkhoffian.h"
 
+#include "birkhoff_cart/core/angle_reduction.h"
+
 namespace birkhoff_cart {
 
 CartBirkhoffianPoint CartBirkhoffianBase::to_birkhoffian(const CartState& state) const {
   const Vector2<double> momentum =
-      model_->momentum(state.steering_angle, Vector2<double>(state.forward_speed, state.steering_rate));  // p = M ω
+      model_->momentum(reduced_angle(state.steering_angle, state.steering_angle_low),
+                       Vector2<double>(state.forward_speed, state.steering_rate));  // p = M ω (M is 2π-periodic in χ)
   CartBirkhoffianPoint point;
   point.z(kArcLengthIndex) = state.arc_length;
-  point.z(kSteeringAngleIndex) = state.steering_angle;
+  point.z(kSteeringAngleIndex) = state.steering_angle;  // the low part is the caller's to carry
   point.z(kForwardMomentumIndex) = momentum(0);
   point.z(kSteeringMomentumIndex) = momentum(1);
   point.y(kXIndex) = state.x;

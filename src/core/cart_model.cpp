@@ -1,5 +1,7 @@
 #include "birkhoff_cart/core/cart_model.h"
 
+#include "birkhoff_cart/core/angle_reduction.h"
+
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -24,12 +26,15 @@ CartModel::CartModel(const CartParameters& parameters, InertiaModel inertia_mode
   }
 }
 
+// T* and p2 are 2π-periodic in χ: evaluated at χ reduced with its low part (angle_reduction.h).
 double CartModel::energy(const CartState& state) const {
-  return kinetic_energy(state.steering_angle, Vector2<double>(state.forward_speed, state.steering_rate));
+  return kinetic_energy(reduced_angle(state.steering_angle, state.steering_angle_low),
+                        Vector2<double>(state.forward_speed, state.steering_rate));
 }
 
 double CartModel::steering_momentum(const CartState& state) const {
-  return momentum(state.steering_angle, Vector2<double>(state.forward_speed, state.steering_rate))(1);
+  return momentum(reduced_angle(state.steering_angle, state.steering_angle_low),
+                  Vector2<double>(state.forward_speed, state.steering_rate))(1);
 }
 
 Eigen::Vector2d CartModel::rear_axle_midpoint(const CartState& state) const {

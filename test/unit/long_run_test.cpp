@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/effects.h"
@@ -33,7 +34,7 @@ struct LongRun {
   double seconds = 0.0;                         ///< wall-clock run time [s] (printed only)
 };
 
-LongRun run(const std::string& integrator) {
+LongRun run(const std::string& integrator, double step_size = kStepSize) {
   const Scene scene =
       load_scene(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/jackknife_whirl.yaml");
   EXPECT_TRUE(scene.effects.empty());
@@ -41,19 +42,19 @@ LongRun run(const std::string& integrator) {
   const EffectSet effects;  // the free cart
   IntegratorSettings settings = scene.integrator;
   settings.name = integrator;
-  settings.step_size = kStepSize;
+  settings.step_size = step_size;
   std::unique_ptr<CartStepper> stepper = make_cart_stepper(settings, model, effects);
   CartState state = scene.initial_state;
   const double energy0 = model.energy(state);
   const double p2_0 = model.steering_momentum(state);
-  const long steps = std::lround(kDuration / kStepSize);
+  const long steps = std::lround(kDuration / step_size);
   const long steps_per_tenth = steps / kTenths;
   StepStatistics statistics;
   LongRun result;
   const auto start = std::chrono::steady_clock::now();
   for (long k = 1; k <= steps; ++k) {
-    stepper->step(state, kStepSize, statistics);
-    state.time = scene.initial_state.time + static_cast<double>(k) * kStepSize;
+    stepper->step(state, step_size, statistics);
+    state.time = scene.initial_state.time + static_cast<double>(k) * step_size;
     const double signed_energy_error = (model.energy(state) - energy0) / energy0;
     const double energy_error = std::abs(signed_energy_error);
     const double p2_error = std::abs(model.steering_momentum(state) - p2_0) / std::abs(p2_0);
@@ -87,6 +88,30 @@ TEST_P(LongRunSymmetric, EnergyErrorStaysBoundedAndP2IsKept) {
 
 INSTANTIATE_TEST_SUITE_P(Birkhoff, LongRunSymmetric, ::testing::Values("birkhoff2", "birkhoff4"),
                          [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
+
+// The higher-order members at step sizes where they reach ~1e-8 m on this run (benchmark), so the
+// test costs what a user would pay, not 10⁶ steps each.
+class LongRunHighOrder : public ::testing::TestWithParam<std::pair<std::string, double>> {};
+
+TEST_P(LongRunHighOrder, EnergyErrorStaysBoundedAndP2IsKept) {
+  const LongRun result = run(GetParam().first, GetParam().second);
+  ASSERT_TRUE(result.finite);
+  std::printf("%s h = %g: first/last tenth max |dT*/T*| %.3e %.3e\n", GetParam().first.c_str(), GetParam().second,
+              result.energy_error[0], result.energy_error[kTenths - 1]);
+  EXPECT_LE(result.energy_error[kTenths - 1], kBoundedGrowthFactor * result.energy_error[0]);
+  EXPECT_LE(result.p2_error, kP2RoundOff);
+}
+
+INSTANTIATE_TEST_SUITE_P(Birkhoff, LongRunHighOrder,
+                         ::testing::Values(std::make_pair(std::string("birkhoff_gauss4"), 0.02),
+                                           std::make_pair(std::string("birkhoff_gauss6"), 0.025),
+                                           std::make_pair(std::string("birkhoff_gauss8"), 0.04),
+                                           std::make_pair(std::string("birkhoff4_suzuki"), 0.02),
+                                           std::make_pair(std::string("birkhoff6_kahan_li"), 0.04),
+                                           std::make_pair(std::string("birkhoff8_kahan_li"), 0.08)),
+                         [](const ::testing::TestParamInfo<std::pair<std::string, double>>& info) {
+                           return info.param.first;
+                         });
 
 class LongRunRungeKutta : public ::testing::TestWithParam<std::string> {};
 

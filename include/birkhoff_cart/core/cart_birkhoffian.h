@@ -55,6 +55,8 @@ class CartBirkhoffianBase {
   CartBirkhoffianBase(const CartModel& model, const EffectSet& effects) : model_(&model), effects_(&effects) {}
 
   const CartModel& model() const { return *model_; }
+  /// Are the rates 2π-periodic in χ (no enabled load that grows with χ)?
+  bool periodic_in_steering_angle() const { return effects_->periodic_in_steering_angle(); }
   bool non_birkhoffian_force_enabled() const { return non_birkhoffian_force_enabled_; }
   /// Disabled: Λ = 0 and no applied loads (the Birkhoffian part; K-symplecticity tests).
   void set_non_birkhoffian_force_enabled(bool enabled) { non_birkhoffian_force_enabled_ = enabled; }

@@ -41,6 +41,8 @@ class Effect {
   virtual const std::string& name() const = 0;
   /// Adds this effect's Q and ∂Q/∂(χ, ω1, ω2) to `total`.
   virtual void add_to(const EffectInput& input, GeneralizedForce& total) const = 0;
+  /// Is Q 2π-periodic in the steering angle χ? (Lets the integrators keep χ reduced; a hinge spring is not.)
+  virtual bool periodic_in_steering_angle() const { return true; }
 };
 
 /// The enabled effects of a scene.
@@ -48,6 +50,13 @@ class EffectSet {
  public:
   void add(std::unique_ptr<Effect> effect);
   bool empty() const { return effects_.empty(); }
+  /// Every enabled effect 2π-periodic in χ?
+  bool periodic_in_steering_angle() const {
+    for (const auto& effect : effects_) {
+      if (!effect->periodic_in_steering_angle()) return false;
+    }
+    return true;
+  }
   std::size_t size() const { return effects_.size(); }
   const std::vector<std::unique_ptr<Effect>>& effects() const { return effects_; }
 

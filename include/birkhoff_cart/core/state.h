@@ -18,6 +18,12 @@ struct CartState {
   double steering_rate = 0.0;                     ///< ω2 = χ̇ [rad/s]
   double applied_work = 0.0;                      ///< W = ∫ ω·Q dt since the start [J] (energy balance)
   double steering_impulse = 0.0;                  ///< I2 = ∫ Q2 dt since the start [N·m·s] (p2 balance)
+  /// Low parts of the unwrapped angles: χ = steering_angle + steering_angle_low, θ = heading + heading_low
+  /// exactly (to ~1e-30 rad). The integrators keep angles reduced with their turns apart; an unwrapped
+  /// double alone would lose the ulp of a many-times-turned angle (4.5e-13 rad at 2262 rad) in every
+  /// function periodic in it. Zero for a state set by hand; readers that need no such precision ignore them.
+  double steering_angle_low = 0.0;                ///< [rad]
+  double heading_low = 0.0;                       ///< [rad]
 };
 
 /// Indices of the Birkhoffian variables z = (π1, χ, p1, p2) of the cart (docs/birkhoffian.md).

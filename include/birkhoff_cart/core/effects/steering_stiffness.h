@@ -14,6 +14,8 @@ class SteeringStiffness : public Effect {
   const std::string& name() const override;
   /// Q2 += −k_s χ;  ∂Q2/∂χ += −k_s.
   void add_to(const EffectInput& input, GeneralizedForce& total) const override;
+  /// Q2 = −k_s χ grows with the turns: the integrators must keep χ unwrapped.
+  bool periodic_in_steering_angle() const override { return false; }
 
  private:
   double coefficient_;  ///< k_s [N·m/rad]

@@ -1,23 +1,21 @@
 // What the Birkhoffian collocation members carry from one step to the next (docs/birkhoffian.md §10.4):
 // the point (z, y) with its compensated-summation remainders, the steering angle χ and heading θ
-// reduced to (−π, π] with whole turns kept apart (the cart's rates are 2π-periodic in both, so the
-// ulp of χ no longer grows with the turns: at χ ≈ 2262 rad it was 4.5e-13 rad), and the memory of
-// stage derivatives for starting values.
+// reduced to (−π, π] with whole turns kept apart (the cart's rates are 2π-periodic in θ always and in χ
+// unless a steering spring is enabled, so the ulp of χ no longer grows with the turns: at χ ≈ 2262 rad
+// it was 4.5e-13 rad), and the memory of stage derivatives and Newton matrices. The CartState handed
+// out carries each angle as hi + lo (state.h), so that diagnostics keep those bits too.
 #pragma once
 
 #include <cmath>
 #include <type_traits>
 #include <utility>
 
+#include "birkhoff_cart/core/angle_reduction.h"
 #include "birkhoff_cart/core/cart_birkhoffian.h"
 #include "birkhoff_cart/core/integrators/gauss_collocation.h"
 #include "birkhoff_cart/core/state.h"
 
 namespace birkhoff_cart {
-
-/// 2π = kTwoPiHigh + kTwoPiLow to about 1e-32 rad.
-constexpr double kTwoPiHigh = 6.283185307179586;       // [rad]
-constexpr double kTwoPiLow = 2.4492935982947064e-16;   // [rad]
 
 /// Steppers with advance_compensated(system, CompensatedPoint&, CollocationMemory&, t, h, statistics).
 template <class Stepper, class System, class = void>
@@ -32,15 +30,6 @@ struct CarriesStateTrait<Stepper, System,
 template <class Stepper, class System>
 constexpr bool kCarriesState = CarriesStateTrait<Stepper, System>::value;
 
-/// Reduces `angle` [rad] (with its remainder [rad]) into (−π, π], adding the removed turns to `turns`.
-inline void reduce_angle(double& angle, double& remainder, double& turns) {
-  const double k = std::nearbyint(angle / kTwoPiHigh);
-  if (k == 0.0) return;
-  angle = std::fma(-k, kTwoPiHigh, angle);  // one rounding; the exact result is near a small number
-  remainder -= k * kTwoPiLow;
-  turns += k;
-}
-
 template <class System, class Memory>
 struct CarriedCartState {
   bool valid = false;
@@ -48,6 +37,7 @@ struct CarriedCartState {
   Memory memory;
   double steering_turns = 0.0;  ///< whole turns removed from χ [-]
   double heading_turns = 0.0;   ///< whole turns removed from θ [-]
+  bool periodic_in_steering_angle = true;  ///< rates 2π-periodic in χ (no steering spring)
   CartState last_output;        ///< what the adapter last handed out
 
   /// Is `state` exactly the state this carried state produced (every field but the time, bit for
@@ -60,33 +50,41 @@ struct CarriedCartState {
     return a.x == b.x && a.y == b.y && a.heading == b.heading &&
            a.steering_angle == b.steering_angle && a.wheel_spin_angle == b.wheel_spin_angle &&
            a.arc_length == b.arc_length && a.forward_speed == b.forward_speed && a.steering_rate == b.steering_rate &&
-           a.applied_work == b.applied_work && a.steering_impulse == b.steering_impulse;
+           a.applied_work == b.applied_work && a.steering_impulse == b.steering_impulse &&
+           a.steering_angle_low == b.steering_angle_low && a.heading_low == b.heading_low;
   }
 
-  /// Starts afresh from a cart state: p = M(χ) ω, no remainders, no memory.
+  /// Starts afresh from a cart state: p = M(χ) ω, the angles' low parts as remainders, no memory.
   void start_from(const System& system, const CartState& state) {
     const CartBirkhoffianPoint fresh = system.to_birkhoffian(state);
     point.z = fresh.z;
     point.y = fresh.y;
     point.z_remainder.setZero();
     point.y_remainder.setZero();
+    point.z_remainder(kSteeringAngleIndex) = state.steering_angle_low;
+    point.y_remainder(kHeadingIndex) = state.heading_low;
     memory.clear();
     steering_turns = 0.0;
     heading_turns = 0.0;
+    periodic_in_steering_angle = system.periodic_in_steering_angle();
     reduce_angles();
     valid = true;
   }
 
   void reduce_angles() {
-    reduce_angle(point.z(kSteeringAngleIndex), point.z_remainder(kSteeringAngleIndex), steering_turns);
+    if (periodic_in_steering_angle) {
+      reduce_angle(point.z(kSteeringAngleIndex), point.z_remainder(kSteeringAngleIndex), steering_turns);
+    }
     reduce_angle(point.y(kHeadingIndex), point.y_remainder(kHeadingIndex), heading_turns);
   }
 
-  /// The cart state at time t [s], angles unwrapped again; remembered for continues().
+  /// The cart state at time t [s], angles unwrapped again as hi + lo; remembered for continues().
   CartState output(const System& system, double t) {
     CartState state = system.to_cart_state(point.z, point.y, t);
-    state.steering_angle = point.z(kSteeringAngleIndex) + steering_turns * kTwoPiHigh;
-    state.heading = point.y(kHeadingIndex) + heading_turns * kTwoPiHigh;
+    unwrap_angle(point.z(kSteeringAngleIndex), point.z_remainder(kSteeringAngleIndex), steering_turns,
+                 state.steering_angle, state.steering_angle_low);
+    unwrap_angle(point.y(kHeadingIndex), point.y_remainder(kHeadingIndex), heading_turns, state.heading,
+                 state.heading_low);
     last_output = state;
     return state;
   }

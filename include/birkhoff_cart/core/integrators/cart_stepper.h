@@ -25,7 +25,7 @@ class CartStepper {
  public:
   virtual ~CartStepper() = default;
   virtual const std::string& name() const = 0;
-  /// Order of accuracy (2 or 4; dopri5 reports 5).
+  /// Order of accuracy (2 … 8; dopri5 reports 5).
   virtual int order() const = 0;
   /// Time-symmetric (self-adjoint) method?
   virtual bool symmetric() const = 0;
@@ -34,7 +34,8 @@ class CartStepper {
   virtual void step(CartState& state, double step_size, StepStatistics& statistics) = 0;
 };
 
-/// Registered names: birkhoff2, birkhoff4, rk2, rk4, dopri5, midpoint.
+/// Registered names: birkhoff2, birkhoff4, rk2, rk4, dopri5, midpoint, birkhoff_gauss4, birkhoff_gauss6,
+/// birkhoff_gauss8, birkhoff4_suzuki, birkhoff6_kahan_li, birkhoff8_kahan_li.
 std::vector<std::string> integrator_names();
 
 /// Makes the named integrator for `model` and `effects` (both must outlive it). Throws
