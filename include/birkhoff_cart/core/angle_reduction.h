@@ -1,6 +1,6 @@
 // Angles kept as a reduced part and whole turns, or as a double-double (hi + lo), so that the ulp of
 // an angle that has turned many times does not decide the accuracy of what is periodic in it
-// (docs/birkhoffian.md §9.4).
+// (docs/birkhoffian.md §10.4).
 #pragma once
 
 #include <cmath>
