@@ -10,6 +10,7 @@
 #include <memory>
 #include <string>
 
+#include "birkhoff_cart/core/angle_reduction.h"
 #include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/effect_library.h"
 #include "birkhoff_cart/core/effects.h"
@@ -94,6 +95,23 @@ TEST(CompensatedSummation, KeepsTheStraightCoastWithinAnUlpWhereThePlainSumDrift
                 integrator.c_str(), with, without);
     EXPECT_LE(with, 4.0 * std::numeric_limits<double>::epsilon() * 12.6) << integrator;
     EXPECT_GE(without, 20.0 * with + 1e-13) << integrator;
+  }
+}
+
+TEST(AngleReduction, UnwrapAndReduceAreExactToTheLowPart) {
+  // reduced + remainder + turns·2π = hi + lo, and reduced_angle(hi, lo) recovers reduced + remainder
+  // to an ulp of the reduced angle, not of hi (long double 2π from its two parts as the check).
+  const long double two_pi = static_cast<long double>(kTwoPiHigh) + static_cast<long double>(kTwoPiLow);
+  for (double turns : {1.0, 17.0, 360.0, -1234.0, 1e5}) {
+    for (double reduced : {0.3, -3.1, 2.9e-3}) {
+      const double remainder = 1.3e-17;
+      double high = 0.0, low = 0.0;
+      unwrap_angle(reduced, remainder, turns, high, low);
+      const long double exact = static_cast<long double>(reduced) + remainder + turns * two_pi;
+      EXPECT_LE(std::fabs((static_cast<long double>(high) + low) - exact), 1e-18L * std::fabs(exact)) << turns;
+      EXPECT_NEAR(reduced_angle(high, low), reduced + remainder, 4.0 * std::numeric_limits<double>::epsilon())
+          << turns << " " << reduced;
+    }
   }
 }
 

@@ -353,6 +353,38 @@ class GaussCollocation {
     return memory.cached_inverse[slot];
   }
 
+  /// (δᵢⱼ I − h aᵢⱼ Jⱼ)⁻¹ with Jⱼ = ∂ẇ/∂w at each stage (AD): the Jacobian of the stage equations
+  /// themselves, for Newton's method where one J for all stages does not converge.
+  template <class System, class S>
+  static typename CollocationMemory<System, Stages>::StageMatrix stage_newton_inverse(
+      const System& system, const GaussLegendreTableau& tableau, const StateVector<System, double>& w,
+      const Stages_<System, S>& increments, const std::array<double, Stages>& stage_times, double h, double t,
+      StepStatistics& statistics) {
+    constexpr int n = System::kDimension;
+    using JetN = newton_detail::JacobianJet<n>;
+    using Matrix = typename CollocationMemory<System, Stages>::StageMatrix;
+    Matrix matrix = Matrix::Identity();
+    for (int j = 0; j < Stages; ++j) {
+      const StateVector<System, double> stage = w + values_of(increments[j]);
+      Eigen::Matrix<JetN, n, 1> stage_jet;
+      for (int k = 0; k < n; ++k) {
+        stage_jet(k).value() = stage(k);
+        stage_jet(k).derivatives() = Eigen::Matrix<double, n, 1, Eigen::DontAlign>::Unit(k);
+      }
+      const Eigen::Matrix<JetN, n, 1> rate = system.darboux_rates(stage_jet, JetN(stage_times[j]));
+      ++statistics.rhs_evaluations;
+      Eigen::Matrix<double, n, n> jacobian;
+      for (int k = 0; k < n; ++k) jacobian.row(k) = rate(k).derivatives().transpose();
+      if (!jacobian.allFinite()) fail("met a non-finite Jacobian", t, 0);
+      for (int i = 0; i < Stages; ++i) {
+        matrix.template block<n, n>(i * n, j * n) -= (h * tableau.coefficients[i][j]) * jacobian;
+      }
+    }
+    const Matrix inverse = matrix.partialPivLu().inverse();
+    if (!inverse.allFinite()) fail("met a singular Newton matrix", t, 0);
+    return inverse;
+  }
+
   /// Solves Zᵢ = r + h Σⱼ aᵢⱼ F(w + Zⱼ, tⱼ) for the stage increments in place by simplified Newton,
   /// Z ← Z − (I − h A ⊗ J)⁻¹ G(Z), G(Z) = Z − r − h (A ⊗ I) F(w + Z), with J from the memory (kept
   /// across steps while the iteration contracts fast; refreshed when it does not). Leaves in
@@ -382,7 +414,9 @@ class GaussCollocation {
     W stage_mean = w;
     for (int i = 0; i < Stages; ++i) stage_mean += increments[i] / S(Stages);
     const auto* inverse = &newton_inverse(system, tableau, values_of(stage_mean), t_jacobian, h, memory, statistics);
-    bool refreshed = false;  // Jacobian recomputed inside this step already
+    int since_refresh = 0;   // iterations since the Jacobian was last recomputed inside this step
+    int refreshes = 0;       // recomputations inside this step
+    typename CollocationMemory<System, Stages>::StageMatrix exact_inverse;  // Newton proper, when needed
 
     std::array<double, n> smallest_change;
     smallest_change.fill(std::numeric_limits<double>::infinity());
@@ -450,20 +484,29 @@ class GaussCollocation {
       }
       growths = (total > previous_total && total > 1e-12) ? growths + 1 : 0;
       previous_total = total;
-      const bool slow = growths >= 2 || iterations >= 8;
-      if (slow && !refreshed) {
-        // Stale Jacobian: recompute it at the current stage mean and go on from the current iterate.
-        stage_mean = w;
-        for (int i = 0; i < Stages; ++i) stage_mean += increments[i] / S(Stages);
+      ++since_refresh;
+      const bool slow = growths >= 2 || since_refresh >= 6;
+      if (slow) {
+        // Stale Jacobian (diverging, or 6 iterations without converging). First: recompute the one J
+        // at the current stage mean (kept for later steps). Again: Newton's method proper, with each
+        // stage's own Jacobian, (I − h A ⊗ J)ᵢⱼ = δᵢⱼ I − h aᵢⱼ Jⱼ (large h, fast dynamics).
         memory.forget_jacobian();
-        inverse = &newton_inverse(system, tableau, values_of(stage_mean), t_jacobian, h, memory, statistics);
-        refreshed = true;
+        if (++refreshes == 1) {
+          stage_mean = w;
+          for (int i = 0; i < Stages; ++i) stage_mean += increments[i] / S(Stages);
+          inverse = &newton_inverse(system, tableau, values_of(stage_mean), t_jacobian, h, memory, statistics);
+        } else {
+          exact_inverse = stage_newton_inverse(system, tableau, values_of(w), increments, stage_times, h, t, statistics);
+          inverse = &exact_inverse;
+        }
+        since_refresh = 0;
         growths = 0;
         previous_total = std::numeric_limits<double>::infinity();
         continue;
       }
-      if (iterations >= settings_.max_iterations) fail("did not converge (simplified Newton)", t, iterations);
+      if (iterations >= settings_.max_iterations) fail("did not converge (Newton)", t, iterations);
     }
+    if (refreshes >= 2) memory.forget_jacobian();  // the per-stage matrix is this step's only
     // Keep J for the next step only while it contracts fast (≤ 0.05 per iteration).
     // (Measured on the whirl, instructions per step: refreshing at 0.02, 0.01 or 0.003 costs more
     // in AD Jacobians and inverses than the iterations it saves.)
