@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "birkhoff_cart/core/integrators/cart_stepper.h"
 #include "test_scenes.h"
 
 namespace birkhoff_cart {
@@ -129,6 +130,9 @@ TEST(CartSimulateRobustness, HelpAndVersionExitZeroOnStdout) {
     EXPECT_EQ(outcome.standard_output.rfind("usage: cart_simulate", 0), 0u) << option;
     EXPECT_NE(outcome.standard_output.find("Exit status"), std::string::npos) << option;
     EXPECT_EQ(outcome.standard_error, "") << option;
+    for (const std::string& name : integrator_names()) {  // every registry member is named
+      EXPECT_NE(outcome.standard_output.find(name), std::string::npos) << name;
+    }
   }
   const Outcome version = run("--version");
   EXPECT_EQ(version.exit_status, 0);
