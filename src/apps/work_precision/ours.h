@@ -1,0 +1,96 @@
+// work_precision: our registry's integrators, run through Simulation exactly as the CLI and the
+// node run them.
+#pragma once
+
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include "bench_scene.h"
+#include "birkhoff_cart/core/simulation.h"
+#include "measurement.h"
+
+namespace birkhoff_cart {
+namespace work_precision {
+
+constexpr double kSampleInterval = 0.1;  // energy / p2 residual sampling period [s] (simulated)
+
+/// The scene with this method and step (for dopri5: the simulator step; tolerance used by dopri5).
+inline Scene configured(const Scene& base, const std::string& method, double step, double tolerance) {
+  Scene scene = base;
+  scene.integrator.name = method;
+  scene.integrator.step_size = step;
+  if (method == "dopri5") scene.integrator.tolerance = tolerance;
+  return scene;
+}
+
+/// Runs `steps` steps; samples the residuals every `sample_every` steps, at the checkpoints and
+/// at the end.
+inline RunErrors run_simulation(const BenchScene& bench, Simulation& sim, std::uint64_t steps,
+                                std::uint64_t sample_every, const std::vector<std::uint64_t>& checkpoints) {
+  RunErrors errors;
+  errors.energy_scale = sim.diagnostics().energy;
+  std::size_t next = 0;
+  for (std::uint64_t k = 1; k <= steps; ++k) {
+    sim.step();
+    while (next < checkpoints.size() && checkpoints[next] < k) ++next;  // skipped checkpoints (index 0)
+    const bool at_checkpoint = next < checkpoints.size() && checkpoints[next] == k;
+    if (k % sample_every == 0 || at_checkpoint) {
+      const Diagnostics d = sim.diagnostics();
+      errors.max_energy_residual = std::max(errors.max_energy_residual, std::abs(d.energy_balance_residual));
+      errors.max_p2_residual = std::max(errors.max_p2_residual, std::abs(d.p2_balance_residual));
+    }
+    if (at_checkpoint) errors.checkpoints.push_back(checkpoint_error(bench, next++, sim.state(), errors.max_energy_residual));
+  }
+  errors.final_state = sim.state();
+  return errors;
+}
+
+/// One of our methods at nominal step h (fixed-step methods) or at `tolerance` with Simulation
+/// step `simulator_step` (dopri5, which restarts odeint's stepper at every Simulation step).
+inline RunRecord measure_ours(const BenchScene& bench, const std::string& method, double nominal_step,
+                              double tolerance, double simulator_step, int repetitions) {
+  RunRecord record;
+  record.scene = bench.label;
+  record.method = method;
+  record.kind = "ours";
+  record.duration = bench.scene.duration;
+  const bool adaptive = method == "dopri5";
+  if (adaptive) {
+    char name[64];
+    std::snprintf(name, sizeof name, "dopri5_sim%gs", simulator_step);
+    record.method = simulator_step == kSampleInterval ? "dopri5" : name;
+  }
+  const std::uint64_t steps = step_count(bench.scene.duration, adaptive ? simulator_step : nominal_step);
+  const double h = bench.scene.duration / static_cast<double>(steps);
+  const std::uint64_t sample_every = std::max<std::uint64_t>(1, std::llround(kSampleInterval / h));
+  if (adaptive) {
+    record.tolerance = tolerance;
+    record.simulator_step = h;
+  } else {
+    record.step_size = h;
+  }
+  const std::vector<std::uint64_t> checkpoints = checkpoint_steps(bench, steps);
+  try {
+    StepStatistics statistics;
+    Simulation sim(configured(bench.scene, method, h, tolerance));  // built outside the timed region
+    const RunErrors errors = timed(repetitions, record, [&] {
+      sim.reset();
+      RunErrors e = run_simulation(bench, sim, steps, sample_every, checkpoints);
+      statistics = sim.statistics();
+      return e;
+    });
+    record.steps = statistics.steps;
+    record.rhs_evaluations = statistics.rhs_evaluations;
+    record.passive_evaluations = statistics.passive_evaluations;
+    record.iterations = statistics.newton_iterations_total;
+    record.errors = errors;
+    fill_final_errors(bench, errors.final_state, record.errors);
+  } catch (const std::exception& error) {
+    record.status = std::string("failed: ") + error.what();
+  }
+  return record;
+}
+
+}  // namespace work_precision
+}  // namespace birkhoff_cart
