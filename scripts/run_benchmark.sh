@@ -1,11 +1,14 @@
 #!/usr/bin/env bash
-# Work–precision benchmark (issue 6; docs/benchmarks.md): build, run the ROS-free work_precision
-# executable from the repository, then plot and tabulate with Debian's python3-matplotlib.
+# Work–precision benchmark (issues 6 and 11; docs/benchmarks.md): build, run the ROS-free
+# work_precision executable from the repository, then plot and tabulate with Debian's
+# python3-matplotlib.
 #
-# Usage: scripts/run_benchmark.sh [--quick] [more work_precision options]
-#   default: ~2½ minutes on a quiet 2-core machine (measured); writes bench/results/*.csv, *.png, work_precision.md
-#   --quick: ~2 s smoke run (3 repetitions, jackknife_whirl 100 s, fewer step sizes) into
-#            /tmp/birkhoff_cart_bench_quick unless --output-dir is given
+# Usage: scripts/run_benchmark.sh [--quick] [more work_precision options, e.g. --only SCENE]
+#   default: 17 min CPU; 53 min 42 s wall at load average 9–15 on the shared 2-core machine
+#            (measured 23 Nov 2026); writes bench/results/*.csv, *.png, work_precision.md
+#   --quick: smoke run (3 repetitions, jackknife_whirl 100 s, 1–3 settings per method): 10.7 s wall,
+#            3.1 s CPU at load 15 (measured with `time`), into /tmp/birkhoff_cart_bench_quick unless
+#            --output-dir is given
 # Environment: BIRKHOFF_CART_WORKSPACE = an already-built catkin workspace to use instead of
 #              running scripts/setup.sh (which builds .ws/).
 set -euo pipefail
@@ -29,6 +32,7 @@ mkdir -p "$output_dir"
 
 cd "$repo"
 echo "load before: $(cat /proc/loadavg)"
+start=$(date +%s)
 "$binary" --output-dir "$output_dir" "$@"
-echo "load after:  $(cat /proc/loadavg)"
+echo "load after:  $(cat /proc/loadavg); work_precision took $(($(date +%s) - start)) s wall"
 /usr/bin/python3 "$repo/bench/bench_plot.py" "$output_dir"
