@@ -6,8 +6,8 @@
 # Usage: scripts/run_benchmark.sh [--quick] [more work_precision options, e.g. --only SCENE]
 #   default: 17 min CPU; 53 min 42 s wall at load average 9–15 on the shared 2-core machine
 #            (measured 23 Nov 2026); writes bench/results/*.csv, *.png, work_precision.md
-#   --quick: smoke run (3 repetitions, jackknife_whirl 100 s, 1–3 settings per method): 10.7 s wall,
-#            3.1 s CPU at load 15 (measured with `time`), into /tmp/birkhoff_cart_bench_quick unless
+#   --quick: smoke run (3 repetitions, jackknife_whirl 100 s, 1–3 settings per method): 47 s wall
+#            with the plots, 6.1 s CPU, at load 11.6 (measured with `time`), into /tmp/birkhoff_cart_bench_quick unless
 #            --output-dir is given
 # Environment: BIRKHOFF_CART_WORKSPACE = an already-built catkin workspace to use instead of
 #              running scripts/setup.sh (which builds .ws/).
