@@ -58,6 +58,10 @@ inline CartState reference_at(const BenchScene& bench, std::size_t j, double tim
 }
 
 inline double position_distance(const CartState& a, const CartState& b) { return std::hypot(a.x - b.x, a.y - b.y); }
+/// θ_a − θ_b with the low parts of the unwrapped headings (state.h) [rad].
+inline double heading_difference(const CartState& a, const CartState& b) {
+  return (a.heading - b.heading) + (a.heading_low - b.heading_low);
+}
 
 inline CheckpointError checkpoint_error(const BenchScene& bench, std::size_t j, const CartState& state,
                                         double max_energy_residual) {
@@ -71,7 +75,7 @@ inline CheckpointError checkpoint_error(const BenchScene& bench, std::size_t j, 
 inline void fill_final_errors(const BenchScene& bench, const CartState& state, RunErrors& errors) {
   const CartState reference = reference_at(bench, bench.checkpoint_times.size() - 1, state.time);
   errors.position_error = position_distance(state, reference);
-  errors.heading_error = std::abs(state.heading - reference.heading);
+  errors.heading_error = std::abs(heading_difference(state, reference));
   errors.arc_length_rel_error = std::abs(state.arc_length - reference.arc_length) / std::abs(reference.arc_length);
   errors.final_state = state;
 }

@@ -109,7 +109,7 @@ inline void write_reference_check(std::FILE* check, const BenchScene& bench, con
     const CartState& b = other.states[j];
     std::fprintf(check, "%s,%s,%s,%.9g,%.3e,%.3e,%.3e,%llu,%.2f,%llu,%.2f\n", bench.label.c_str(),
                  reference.name.c_str(), other.name.c_str(), bench.checkpoint_times[j], position_distance(a, b),
-                 std::abs(a.heading - b.heading), std::abs(a.arc_length - b.arc_length),
+                 std::abs(heading_difference(a, b)), std::abs(a.arc_length - b.arc_length),
                  static_cast<unsigned long long>(reference.rhs_evaluations), reference.wall,
                  static_cast<unsigned long long>(other.rhs_evaluations), other.wall);
   }
@@ -181,7 +181,7 @@ inline void prepare_reference(BenchScene& bench, const ReferenceSet* shared, std
   const std::size_t last = bench.checkpoint_times.size() - 1;
   const ReferenceRun& estimate = checks.front();
   bench.reference_error_position = position_distance(reference.states[last], estimate.states[last]);
-  bench.reference_error_heading = std::abs(reference.states[last].heading - estimate.states[last].heading);
+  bench.reference_error_heading = std::abs(heading_difference(reference.states[last], estimate.states[last]));
   for (const ReferenceRun& other : checks) write_reference_check(check, bench, reference, other);
   std::fprintf(stderr, "  reference %s (%.1f s wall): vs %s at the end %.2e m\n", reference.name.c_str(),
                reference.wall, estimate.name.c_str(), bench.reference_error_position);
