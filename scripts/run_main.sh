@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # The main job (README): set up and build, then run the ROS simulator headless in fast mode on the
 # default scene for 60 s of simulated time, recording a compressed bag, and print the bag's
-# `rosbag info` and the node's one-paragraph summary. Needs no display and no stdin; roslaunch
-# starts its own master on a free port and exits when cart_sim (required) finishes.
+# `rosbag info`, the node's one-paragraph summary and a picture of the run drawn from the bag
+# (plot_bag: path, steering angle, speed, error diagnostics). Needs no display and no stdin;
+# roslaunch starts its own master on a free port and exits when cart_sim (required) finishes.
 #
-# Usage: scripts/run_main.sh   → output/main.bag, output/main_summary.txt
+# Usage: scripts/run_main.sh   → output/main.bag, output/main_summary.txt, output/main.png
 # Developers with their own built workspace: BIRKHOFF_CART_WORKSPACE=/path/to/ws skips set-up and
 # uses that workspace instead of .ws/.
 set -euo pipefail
@@ -20,7 +21,8 @@ output="$repo/output"
 mkdir -p "$output"
 bag="$output/main.bag"
 summary="$output/main_summary.txt"
-rm -f "$bag" "$bag.active" "$summary"
+picture="$output/main.png"
+rm -f "$bag" "$bag.active" "$summary" "$picture"
 
 # A private master on a free port, so a roscore already running elsewhere is left alone.
 port="$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("", 0)); print(s.getsockname()[1])')"
@@ -38,6 +40,10 @@ if [ ! -f "$bag" ]; then
   exit 1
 fi
 rosbag info "$bag"
+
+echo
+echo "== rosrun birkhoff_cart plot_bag $bag"
+rosrun birkhoff_cart plot_bag "$bag" -o "$picture"
 
 echo
 echo "== cart_sim summary"
