@@ -1,0 +1,64 @@
+// cmd_vel_controller: the ROS side of CmdVelController (README.md, "Node cmd_vel_controller").
+//
+// Subscribes cmd_vel (geometry_msgs/Twist: linear.x = v* of base_link [m/s], angular.z = r* [rad/s]),
+// odom (v_A = twist.linear.x) and joint_states (χ, χ̇ of ~steering_joint); publishes steering_torque
+// and drive_torque (std_msgs/Float64 [N·m]) for cart_sim on a scene whose torques come from
+// commands (config/scenes/driven.yaml).
+//
+// Timing: one control update per simulator instant, when odom and joint_states with the same stamp
+// have both arrived, so the loop runs at cart_sim's ~publish_rate of scene time in real-time and in
+// fast/lockstep mode alike and never reads the wall clock. A cmd_vel counts as received at the
+// stamp of the latest simulator instant seen, so ~cmd_vel_timeout is scene time even when
+// /use_sim_time is false.
+#pragma once
+
+#include <string>
+
+#include <geometry_msgs/Twist.h>
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
+
+#include "birkhoff_cart/ros/cmd_vel_controller.h"
+
+namespace birkhoff_cart {
+
+/// Reads every private parameter (names as in ros_controllers: cmd_vel_timeout, wheel_separation_h,
+/// linear/x/max_velocity, ..., steering/p, drive/max_torque ...). Throws std::invalid_argument
+/// naming the first bad one.
+CmdVelControllerSettings load_cmd_vel_controller_settings(const ros::NodeHandle& private_node);
+
+class CmdVelControllerNode {
+ public:
+  /// Throws std::invalid_argument for a bad parameter.
+  CmdVelControllerNode(ros::NodeHandle node, ros::NodeHandle private_node);
+
+ private:
+  void on_cmd_vel(const geometry_msgs::Twist::ConstPtr& message);
+  void on_odometry(const nav_msgs::Odometry::ConstPtr& message);
+  void on_joint_states(const sensor_msgs::JointState::ConstPtr& message);
+  /// Runs the law when odom and joint_states of the same instant are both in.
+  void update_if_complete();
+
+  ros::NodeHandle node_;
+  ros::NodeHandle private_node_;
+  CmdVelController controller_;
+  std::string steering_joint_;  ///< ~steering_joint: the hinge's name in joint_states
+
+  ros::Subscriber cmd_vel_subscriber_;
+  ros::Subscriber odometry_subscriber_;
+  ros::Subscriber joint_state_subscriber_;
+  ros::Publisher steering_publisher_;
+  ros::Publisher drive_publisher_;
+
+  ros::Time odometry_stamp_;      ///< stamp of the latest odom
+  double base_speed_ = 0.0;       ///< its v_A [m/s]
+  ros::Time joint_stamp_;         ///< stamp of the latest joint_states holding ~steering_joint
+  double steering_angle_ = 0.0;   ///< χ [rad]
+  double steering_rate_ = 0.0;    ///< χ̇ [rad/s]
+  ros::Time last_update_stamp_;   ///< the instant the law last ran on
+  ros::Time latest_stamp_;        ///< the latest simulator instant seen (cmd_vel arrival time)
+  bool timeout_reported_ = false;
+};
+
+}  // namespace birkhoff_cart

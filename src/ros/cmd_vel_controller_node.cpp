@@ -1,0 +1,174 @@
+// cmd_vel_controller's ROS side (see cmd_vel_controller_node.h): parameters, topics, stamps.
+#include "birkhoff_cart/ros/cmd_vel_controller_node.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <std_msgs/Float64.h>
+
+namespace birkhoff_cart {
+namespace {
+
+// Doubles may be written as integers (max_torque: 50) or, from roslaunch <param> without a type,
+// as strings ("1e-3").
+double read_double(const ros::NodeHandle& node, const std::string& name, double fallback) {
+  XmlRpc::XmlRpcValue value;
+  if (!node.getParam(name, value)) return fallback;
+  if (value.getType() == XmlRpc::XmlRpcValue::TypeDouble) return static_cast<double>(value);
+  if (value.getType() == XmlRpc::XmlRpcValue::TypeInt) return static_cast<int>(value);
+  if (value.getType() == XmlRpc::XmlRpcValue::TypeString) {
+    const std::string text = static_cast<std::string>(value);
+    try {
+      std::size_t used = 0;
+      const double parsed = std::stod(text, &used);
+      if (used == text.size()) return parsed;
+    } catch (const std::exception&) {
+    }
+  }
+  throw std::invalid_argument("parameter " + node.resolveName(name) + " must be a number");
+}
+
+// ros_controllers' has_*_limits switches: false lifts the limit (to ±∞ for values; very large for
+// rates, which must stay finite).
+bool read_switch(const ros::NodeHandle& node, const std::string& name) {
+  XmlRpc::XmlRpcValue value;
+  if (!node.getParam(name, value)) return true;
+  if (value.getType() != XmlRpc::XmlRpcValue::TypeBoolean) {
+    throw std::invalid_argument("parameter " + node.resolveName(name) + " must be true or false");
+  }
+  return static_cast<bool>(value);
+}
+
+constexpr double kNoLimit = 1e9;  // stands for "unlimited" in a finite-limit slot
+
+}  // namespace
+
+CmdVelControllerSettings load_cmd_vel_controller_settings(const ros::NodeHandle& p) {
+  CmdVelControllerSettings s;
+  s.wheel_separation_h = read_double(p, "wheel_separation_h", s.wheel_separation_h);
+  s.cmd_vel_timeout = read_double(p, "cmd_vel_timeout", s.cmd_vel_timeout);
+  s.zero_speed = read_double(p, "zero_speed", s.zero_speed);
+  s.max_velocity = read_double(p, "linear/x/max_velocity", s.max_velocity);
+  s.min_velocity = read_double(p, "linear/x/min_velocity", s.min_velocity);
+  if (!read_switch(p, "linear/x/has_velocity_limits")) {
+    s.max_velocity = kNoLimit;
+    s.min_velocity = -kNoLimit;
+  }
+  s.max_acceleration = read_double(p, "linear/x/max_acceleration", s.max_acceleration);
+  s.min_acceleration = read_double(p, "linear/x/min_acceleration", s.min_acceleration);
+  if (!read_switch(p, "linear/x/has_acceleration_limits")) {
+    s.max_acceleration = kNoLimit;
+    s.min_acceleration = -kNoLimit;
+  }
+  s.max_yaw_rate = read_double(p, "angular/z/max_velocity", s.max_yaw_rate);
+  if (!read_switch(p, "angular/z/has_velocity_limits")) s.max_yaw_rate = kNoLimit;
+  s.max_yaw_acceleration = read_double(p, "angular/z/max_acceleration", s.max_yaw_acceleration);
+  if (!read_switch(p, "angular/z/has_acceleration_limits")) s.max_yaw_acceleration = kNoLimit;
+  s.max_steering_angle = read_double(p, "steering/max_angle", s.max_steering_angle);
+  s.max_steering_rate = read_double(p, "steering/max_rate", s.max_steering_rate);
+  s.max_steering_torque = read_double(p, "steering/max_torque", s.max_steering_torque);
+  s.steering_p = read_double(p, "steering/p", s.steering_p);
+  s.steering_d = read_double(p, "steering/d", s.steering_d);
+  s.max_drive_torque = read_double(p, "drive/max_torque", s.max_drive_torque);
+  s.drive_ff = read_double(p, "drive/ff", s.drive_ff);
+  s.drive_p = read_double(p, "drive/p", s.drive_p);
+  s.drive_i = read_double(p, "drive/i", s.drive_i);
+  s.drive_i_clamp = read_double(p, "drive/i_clamp", s.drive_i_clamp);
+  try {
+    validate(s);
+  } catch (const std::invalid_argument& error) {
+    throw std::invalid_argument("parameter " + p.resolveName("") + "/" + error.what());
+  }
+  return s;
+}
+
+CmdVelControllerNode::CmdVelControllerNode(ros::NodeHandle node, ros::NodeHandle private_node)
+    : node_(node),
+      private_node_(private_node),
+      controller_(load_cmd_vel_controller_settings(private_node)),
+      steering_joint_(private_node.param<std::string>("steering_joint", "steering_joint")) {
+  steering_publisher_ = node_.advertise<std_msgs::Float64>("steering_torque", 10);
+  drive_publisher_ = node_.advertise<std_msgs::Float64>("drive_torque", 10);
+  cmd_vel_subscriber_ = node_.subscribe("cmd_vel", 10, &CmdVelControllerNode::on_cmd_vel, this);
+  odometry_subscriber_ = node_.subscribe("odom", 10, &CmdVelControllerNode::on_odometry, this,
+                                         ros::TransportHints().tcpNoDelay());
+  joint_state_subscriber_ = node_.subscribe("joint_states", 10, &CmdVelControllerNode::on_joint_states, this,
+                                            ros::TransportHints().tcpNoDelay());
+  const CmdVelControllerSettings& s = controller_.settings();
+  ROS_INFO("cmd_vel_controller: %s -> %s, %s; l = %g m, v in [%g, %g] m/s, |r| <= %g rad/s, |chi| <= %g rad, "
+           "|tau| <= %g N m, |T| <= %g N m, cmd_vel_timeout %g s",
+           cmd_vel_subscriber_.getTopic().c_str(), steering_publisher_.getTopic().c_str(),
+           drive_publisher_.getTopic().c_str(), s.wheel_separation_h, s.min_velocity, s.max_velocity, s.max_yaw_rate,
+           s.max_steering_angle, s.max_steering_torque, s.max_drive_torque, s.cmd_vel_timeout);
+}
+
+void CmdVelControllerNode::on_cmd_vel(const geometry_msgs::Twist::ConstPtr& message) {
+  const double time = latest_stamp_.toSec();
+  if (!controller_.set_command(message->linear.x, message->angular.z, time)) {
+    ROS_ERROR_THROTTLE(1.0, "cmd_vel_controller: ignoring a non-finite cmd_vel (linear.x %g, angular.z %g)",
+                       message->linear.x, message->angular.z);
+    return;
+  }
+  const CmdVelControllerSettings& s = controller_.settings();
+  if (message->linear.x > s.max_velocity || message->linear.x < s.min_velocity ||
+      std::abs(message->angular.z) > s.max_yaw_rate) {
+    ROS_WARN_THROTTLE(2.0, "cmd_vel_controller: cmd_vel (%g m/s, %g rad/s) beyond the limits [%g, %g] m/s, "
+                      "|r| <= %g rad/s: clamped", message->linear.x, message->angular.z, s.min_velocity,
+                      s.max_velocity, s.max_yaw_rate);
+  }
+  if (message->linear.y != 0.0 || message->angular.x != 0.0 || message->angular.y != 0.0 ||
+      message->linear.z != 0.0) {
+    ROS_WARN_THROTTLE(5.0, "cmd_vel_controller: a cart moves only along x and turns only about z: ignoring the "
+                      "other components of cmd_vel");
+  }
+  timeout_reported_ = false;
+}
+
+void CmdVelControllerNode::on_odometry(const nav_msgs::Odometry::ConstPtr& message) {
+  odometry_stamp_ = message->header.stamp;
+  base_speed_ = message->twist.twist.linear.x;
+  update_if_complete();
+}
+
+void CmdVelControllerNode::on_joint_states(const sensor_msgs::JointState::ConstPtr& message) {
+  const auto joint = std::find(message->name.begin(), message->name.end(), steering_joint_);
+  if (joint == message->name.end()) return;  // another publisher's joints
+  const std::size_t index = static_cast<std::size_t>(joint - message->name.begin());
+  if (index >= message->position.size() || index >= message->velocity.size()) {
+    ROS_WARN_THROTTLE(5.0, "cmd_vel_controller: joint_states without position and velocity of %s",
+                      steering_joint_.c_str());
+    return;
+  }
+  joint_stamp_ = message->header.stamp;
+  steering_angle_ = message->position[index];
+  steering_rate_ = message->velocity[index];
+  update_if_complete();
+}
+
+void CmdVelControllerNode::update_if_complete() {
+  if (odometry_stamp_ != joint_stamp_ || odometry_stamp_ == last_update_stamp_) return;
+  if (odometry_stamp_ < last_update_stamp_) {
+    ROS_INFO("cmd_vel_controller: time went back to %.6f s (simulator reset): restarting", odometry_stamp_.toSec());
+  }
+  last_update_stamp_ = odometry_stamp_;
+  latest_stamp_ = odometry_stamp_;
+  CartFeedback feedback;
+  feedback.time = odometry_stamp_.toSec();
+  feedback.base_speed = base_speed_;
+  feedback.steering_angle = steering_angle_;
+  feedback.steering_rate = steering_rate_;
+  const ActuatorCommand command = controller_.update(feedback);
+  if (controller_.timed_out() && !timeout_reported_) {
+    ROS_WARN("cmd_vel_controller: no cmd_vel for %g s at t = %.6f s: braking to rest",
+             controller_.settings().cmd_vel_timeout, feedback.time);
+    timeout_reported_ = true;
+  }
+  std_msgs::Float64 torque;
+  torque.data = command.steering_torque;
+  steering_publisher_.publish(torque);
+  torque.data = command.drive_torque;
+  drive_publisher_.publish(torque);
+}
+
+}  // namespace birkhoff_cart

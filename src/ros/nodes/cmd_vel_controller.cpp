@@ -1,0 +1,18 @@
+// cmd_vel_controller: drives cart_sim from geometry_msgs/Twist on cmd_vel (README.md, "Node
+// cmd_vel_controller"). All the work is in CmdVelControllerNode and CmdVelController.
+#include <ros/ros.h>
+
+#include "birkhoff_cart/ros/cmd_vel_controller_node.h"
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "cmd_vel_controller");
+  ros::NodeHandle node_handle;
+  try {
+    birkhoff_cart::CmdVelControllerNode node(node_handle, ros::NodeHandle("~"));
+    ros::spin();
+  } catch (const std::invalid_argument& error) {
+    ROS_FATAL("cmd_vel_controller: bad parameter: %s", error.what());
+    return 2;
+  }
+  return 0;
+}
