@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Set-up for birkhoff_cart on Debian bookworm, as root: install the Debian packages the project
-# needs (only those missing), make the catkin workspace .ws/ (its src/ links to this repository)
-# and build it. Idempotent: with nothing changed a second run takes seconds.
+# needs (only those missing), make the catkin workspace .ws/ (its package directory links to this
+# repository's files) and build it. Idempotent: with nothing changed a second run takes seconds.
 #
 # Usage: scripts/setup.sh            (then: source .ws/devel/setup.bash)
 set -euo pipefail
@@ -20,6 +20,9 @@ packages=(
   libdiagnostic-updater-dev libdiagnostic-msgs-dev
   python3-rostest python3-rosbag python3-rostopic python3-roslaunch python3-rosnode
   python3-rosservice python3-tf2-ros python3-rosgraph-msgs python3-catkin-pkg python3-empy
+  # the message classes `rostopic echo` needs for odom, joint_states, /diagnostics, /tf, cmd_vel
+  python3-std-msgs python3-geometry-msgs python3-nav-msgs python3-sensor-msgs python3-diagnostic-msgs
+  python3-tf2-msgs
   rosbash ros-robot-state-publisher liburdf-dev rviz xvfb
   libboost-dev libyaml-cpp-dev libeigen3-dev googletest libgtest-dev
   python3-matplotlib python3-numpy
@@ -37,11 +40,25 @@ if ((${#missing[@]})); then
   apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
+# The workspace's package directory .ws/src/birkhoff_cart is a real directory of links to the
+# repository's top-level entries, all but .ws itself (and git's and the outputs' directories).
+# ROS_PACKAGE_PATH (= .ws/src) then never leads back into .ws: a link to the whole repository made
+# rosrun's `find -L` report "File system loop detected" and find every executable twice.
 workspace="$repo/.ws"
+package_dir="$workspace/src/birkhoff_cart"
 mkdir -p "$workspace/src"
-if [ ! -L "$workspace/src/birkhoff_cart" ]; then
-  ln -sfn "$repo" "$workspace/src/birkhoff_cart"
-fi
+if [ -L "$package_dir" ]; then rm -f "$package_dir"; fi  # the earlier layout: a link to the repository
+mkdir -p "$package_dir"
+shopt -s dotglob nullglob
+for entry in "$package_dir"/*; do  # links whose target left the repository
+  if [ -L "$entry" ] && [ ! -e "$entry" ]; then rm -f "$entry"; fi
+done
+for entry in "$repo"/*; do
+  name="$(basename "$entry")"
+  case "$name" in .ws | .ws_* | .git | output | build | devel | install) continue ;; esac
+  if [ "$(readlink "$package_dir/$name" 2>/dev/null)" != "$entry" ]; then ln -sfn "$entry" "$package_dir/$name"; fi
+done
+shopt -u dotglob nullglob
 
 # catkin's generated setup files read unset variables; keep `set -u` out of them.
 set +u
