@@ -10,7 +10,7 @@ namespace birkhoff_cart {
 CommandChannel::CommandChannel(double initial_torque, double max_torque, double timeout, double start_time)
     : initial_torque_(initial_torque), max_torque_(max_torque), timeout_(timeout) {
   if (!std::isfinite(max_torque) || max_torque <= 0.0) {
-    throw std::invalid_argument("maximum torque must be finite and > 0 N·m, got " + std::to_string(max_torque));
+    throw std::invalid_argument("maximum torque must be finite and > 0 N m, got " + std::to_string(max_torque));
   }
   if (!std::isfinite(timeout) || timeout < 0.0) {
     throw std::invalid_argument("command timeout must be finite and >= 0 s, got " + std::to_string(timeout));

@@ -10,10 +10,6 @@ namespace birkhoff_cart {
 namespace ros_conversions {
 namespace {
 
-// The simulator's state is exact up to integration error, and the motion is planar by
-// construction: every pose and twist variance is this small constant [m², rad², (m/s)², (rad/s)²].
-constexpr double kSimulatorVariance = 1e-12;
-
 geometry_msgs::Quaternion yaw_quaternion(double yaw) {
   tf2::Quaternion rotation;
   rotation.setRPY(0.0, 0.0, yaw);
@@ -25,9 +21,9 @@ geometry_msgs::Quaternion yaw_quaternion(double yaw) {
   return message;
 }
 
-void set_diagonal(boost::array<double, 36>& covariance, double variance) {
+void set_diagonal(boost::array<double, 36>& covariance, const std::array<double, 6>& variances) {
   covariance.fill(0.0);
-  for (int i = 0; i < 6; ++i) covariance[i * 6 + i] = variance;
+  for (int i = 0; i < 6; ++i) covariance[i * 6 + i] = variances[i];
 }
 
 const TorqueProfile* find_profile(const Scene& scene, const std::string& effect_name) {
@@ -54,7 +50,16 @@ ros::Time to_ros_time(double time) {
   return ros::Time(time);
 }
 
-nav_msgs::Odometry to_odometry(const CartState& state, const CartModel& model, const FrameNames& frames) {
+FrameNames prefixed_frames(const std::string& prefix, const std::string& odom, const std::string& base_link) {
+  FrameNames frames;
+  frames.odom = prefix + odom;
+  frames.base_link = prefix + base_link;
+  frames.joint_prefix = prefix;
+  return frames;
+}
+
+nav_msgs::Odometry to_odometry(const CartState& state, const CartModel& model, const FrameNames& frames,
+                               const OdometryCovariance& covariance) {
   const Eigen::Vector2d rear_axle_midpoint = model.rear_axle_midpoint(state);  // A [m]
   const Vector2<double> quasi_velocity(state.forward_speed, state.steering_rate);
   const CoordinateRates<double> rates = model.coordinate_rates(state.heading, state.steering_angle, quasi_velocity);
@@ -67,11 +72,11 @@ nav_msgs::Odometry to_odometry(const CartState& state, const CartModel& model, c
   odometry.pose.pose.position.y = rear_axle_midpoint.y();
   odometry.pose.pose.position.z = 0.0;
   odometry.pose.pose.orientation = yaw_quaternion(state.heading);
-  set_diagonal(odometry.pose.covariance, kSimulatorVariance);
+  set_diagonal(odometry.pose.covariance, covariance.pose_diagonal);
   // v_A = ω1 cos χ along e: A has no lateral speed (eq. (2.3), constraint (15)) [m/s].
   odometry.twist.twist.linear.x = state.forward_speed * std::cos(state.steering_angle);
   odometry.twist.twist.angular.z = rates.heading_rate;  // θ̇ = ω1 sin χ / l [rad/s]
-  set_diagonal(odometry.twist.covariance, kSimulatorVariance);
+  set_diagonal(odometry.twist.covariance, covariance.twist_diagonal);
   return odometry;
 }
 
@@ -90,14 +95,15 @@ geometry_msgs::TransformStamped to_transform(const CartState& state, const CartM
 }
 
 sensor_msgs::JointState to_joint_state(const CartState& state, const CartModel& model,
-                                       const ActuatorEfforts& efforts) {
+                                       const ActuatorEfforts& efforts, const std::string& joint_prefix) {
   const Vector2<double> quasi_velocity(state.forward_speed, state.steering_rate);
   const CoordinateRates<double> rates = model.coordinate_rates(state.heading, state.steering_angle, quasi_velocity);
 
   sensor_msgs::JointState joints;
   joints.header.stamp = to_ros_time(state.time);
   const auto& names = joint_names();
-  joints.name.assign(names.begin(), names.end());
+  joints.name.reserve(names.size());
+  for (const std::string& name : names) joints.name.push_back(joint_prefix + name);
   joints.position = {state.steering_angle, state.wheel_spin_angle[0], state.wheel_spin_angle[1],
                      state.wheel_spin_angle[2], state.wheel_spin_angle[3]};
   joints.velocity = {state.steering_rate, rates.wheel_spin_rate[0], rates.wheel_spin_rate[1],

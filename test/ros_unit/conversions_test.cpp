@@ -45,10 +45,40 @@ TEST(Conversions, OdometryIsBaseLinkAtTheRearAxleMidpoint) {
   EXPECT_NEAR(odometry.twist.twist.linear.x, 2.0 * std::cos(0.3), kExact);      // v_A = ω1 cos χ
   EXPECT_EQ(odometry.twist.twist.linear.y, 0.0);                                 // no lateral slip at A
   EXPECT_NEAR(odometry.twist.twist.angular.z, 2.0 * std::sin(0.3) / l, kExact);  // θ̇ = ω1 sin χ / l
+  const ros_conversions::OdometryCovariance defaults;
   for (int i = 0; i < 6; ++i) {
-    EXPECT_GT(odometry.pose.covariance[i * 7], 0.0);
-    EXPECT_GT(odometry.twist.covariance[i * 7], 0.0);
+    EXPECT_EQ(odometry.pose.covariance[i * 7], defaults.pose_diagonal[i]);
+    EXPECT_EQ(odometry.twist.covariance[i * 7], defaults.twist_diagonal[i]);
+    EXPECT_GT(odometry.pose.covariance[i * 7], 0.0) << "a zero variance cannot be inverted by a filter";
   }
+  EXPECT_GT(defaults.pose_diagonal[0], 1e-10) << "x: the default scene's integration error is ~1e-5 m";
+}
+
+TEST(Conversions, OdometryCarriesTheGivenCovariance) {
+  const CartModel model{CartParameters{}};
+  ros_conversions::OdometryCovariance covariance;
+  covariance.pose_diagonal = {1.0, 2.0, 3.0, 4.0, 5.0, 6.0};
+  covariance.twist_diagonal = {7.0, 8.0, 9.0, 10.0, 11.0, 12.0};
+  const nav_msgs::Odometry odometry = ros_conversions::to_odometry(moving_state(), model, {}, covariance);
+  for (int row = 0; row < 6; ++row) {
+    for (int column = 0; column < 6; ++column) {
+      EXPECT_EQ(odometry.pose.covariance[row * 6 + column], row == column ? row + 1.0 : 0.0);
+      EXPECT_EQ(odometry.twist.covariance[row * 6 + column], row == column ? row + 7.0 : 0.0);
+    }
+  }
+}
+
+TEST(Conversions, FramePrefixGoesBeforeFramesAndJoints) {
+  const CartModel model{CartParameters{}};
+  const ros_conversions::FrameNames frames = ros_conversions::prefixed_frames("cart2/", "odom", "base_link");
+  const nav_msgs::Odometry odometry = ros_conversions::to_odometry(moving_state(), model, frames);
+  EXPECT_EQ(odometry.header.frame_id, "cart2/odom");
+  EXPECT_EQ(odometry.child_frame_id, "cart2/base_link");
+  const sensor_msgs::JointState joints =
+      ros_conversions::to_joint_state(moving_state(), model, {}, frames.joint_prefix);
+  ASSERT_EQ(joints.name.size(), 5u);
+  EXPECT_EQ(joints.name[0], "cart2/steering_joint");
+  EXPECT_EQ(joints.name[4], "cart2/front_right_wheel_joint");
 }
 
 TEST(Conversions, TransformMatchesOdometry) {

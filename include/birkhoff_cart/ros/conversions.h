@@ -23,10 +23,26 @@ namespace ros_conversions {
 /// Joint names of urdf/cart.urdf, in the order of JointState messages: χ, φ1, φ2, φ3, φ4.
 const std::array<std::string, 5>& joint_names();
 
-/// Frame names of the published odometry and transform.
+/// Frame and joint names of one cart. Several carts under one master each take a prefix
+/// (cart_sim's ~frame_prefix, e.g. "cart1/"): it goes before both frames and every joint name.
 struct FrameNames {
   std::string odom = "odom";            ///< fixed frame
   std::string base_link = "base_link";  ///< rear-axle midpoint A on the ground
+  std::string joint_prefix;             ///< before every joint name in joint_states ("" = the URDF's)
+};
+
+/// `prefix` + odom, `prefix` + base_link, and `prefix` as the joint prefix.
+FrameNames prefixed_frames(const std::string& prefix, const std::string& odom, const std::string& base_link);
+
+/// The variances the odometry claims (diagonals of its pose and twist covariances, in the order
+/// x, y, z, roll, pitch, yaw) [m², rad²; (m/s)², (rad/s)²]. cart_sim's ~pose_covariance_diagonal and
+/// ~twist_covariance_diagonal (ros_controllers' names). The state is the integrated model's, so its
+/// error is the integration error (the default scene ends 1e-5 m from its dopri5 reference after
+/// 60 s): (1 mm)², (1 mrad)² and (1 mm/s)², (1 mrad/s)² bound it with room. z, roll and pitch are
+/// zero by construction of the planar model: 1e-9, small but invertible for filters.
+struct OdometryCovariance {
+  std::array<double, 6> pose_diagonal = {1e-6, 1e-6, 1e-9, 1e-9, 1e-9, 1e-6};
+  std::array<double, 6> twist_diagonal = {1e-6, 1e-6, 1e-9, 1e-9, 1e-9, 1e-6};
 };
 
 /// The torques the actuators apply at one instant (joint efforts).
@@ -43,17 +59,18 @@ constexpr double kLatestRosTime = 4294967295.0;
 ros::Time to_ros_time(double time);
 
 /// nav_msgs/Odometry of base_link (A, heading θ) in odom; twist in base_link:
-/// linear.x = v_A = ω1 cos χ, angular.z = θ̇ = ω1 sin χ / l (docs eqs. (2.3)).
-nav_msgs::Odometry to_odometry(const CartState& state, const CartModel& model, const FrameNames& frames);
+/// linear.x = v_A = ω1 cos χ, angular.z = θ̇ = ω1 sin χ / l (docs eqs. (2.3)); covariances diagonal.
+nav_msgs::Odometry to_odometry(const CartState& state, const CartModel& model, const FrameNames& frames,
+                               const OdometryCovariance& covariance = OdometryCovariance{});
 
 /// odom → base_link transform of the state (same pose as to_odometry).
 geometry_msgs::TransformStamped to_transform(const CartState& state, const CartModel& model,
                                              const FrameNames& frames);
 
 /// Joint positions (χ, φ1..φ4) [rad], velocities (ω2, φ̇1..φ̇4) [rad/s] and actuator efforts
-/// (τ, T/2, T/2, 0, 0) [N·m].
+/// (τ, T/2, T/2, 0, 0) [N·m]. Joint names are `joint_prefix` + joint_names().
 sensor_msgs::JointState to_joint_state(const CartState& state, const CartModel& model,
-                                       const ActuatorEfforts& efforts);
+                                       const ActuatorEfforts& efforts, const std::string& joint_prefix = "");
 
 /// The torques the scene's steering_torque and drive_torque effects apply at the simulation's
 /// current time (the command in force for a command source, the profile otherwise; 0 without the
