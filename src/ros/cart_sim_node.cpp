@@ -72,9 +72,24 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
                            " s: cart_sim publishes scene time as ROS time, which ends before 2^32 s = " +
                            format_seconds(ros_conversions::kLatestRosTime) + " s");
   }
+  // Stamps are scene time; a node on wall time would see them decades in the past. A follower of
+  // another node's /clock needs that clock.
+  bool use_sim_time = false;
+  node_.param("/use_sim_time", use_sim_time, false);
+  if (parameters_.follow_clock && !use_sim_time) {
+    throw NodeStartupError("~follow_clock is true but /use_sim_time is false: there is no /clock to follow; "
+                           "set /use_sim_time true");
+  }
+  if (!use_sim_time) {
+    ROS_WARN("cart_sim: /use_sim_time is false, but every stamp cart_sim publishes is scene time (from t0 = %s s) "
+             "and it drives /clock: nodes on wall time (tf listeners, rviz, robot_state_publisher) will drop "
+             "its messages as too old. Set /use_sim_time true before starting them (every launch file of "
+             "birkhoff_cart does).", format_seconds(start_time).c_str());
+  }
   publish_period_ = 1.0 / parameters_.publish_rate;
   double real_time_factor = parameters_.real_time_factor;
   if (!parameters_.fast && real_time_factor == 0.0) real_time_factor = 1.0;
+  if (parameters_.follow_clock) real_time_factor = 0.0;  // the leader's /clock is the pace
   pacing_ = WallClockPacing(real_time_factor);
 
   if (simulation_->accepts_steering_command()) {
@@ -149,11 +164,15 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
 
   paused_ = parameters_.start_paused;
   restart_schedule();
-  ROS_INFO("cart_sim: scene '%s' (%s), integrator %s, h = %g s, %s mode%s, publish %g Hz, end t = %s s%s%s",
+  ROS_INFO("cart_sim: scene '%s' (%s), integrator %s, h = %g s, %s mode%s, publish %g Hz, end t = %s s, frames %s -> "
+           "%s, %s%s%s",
            simulation_->scene().name.c_str(), parameters_.scene_path.c_str(), simulation_->integrator_name().c_str(),
            simulation_->step_size(), parameters_.fast ? "fast" : "real-time", parameters_.lockstep ? ", lockstep" : "",
-           parameters_.publish_rate, format_seconds(end_time_).c_str(), recorder_ ? ", recording to " : "",
-           recorder_ ? recorder_->path().c_str() : "");
+           parameters_.publish_rate, format_seconds(end_time_).c_str(), parameters_.frames.odom.c_str(),
+           parameters_.frames.base_link.c_str(),
+           parameters_.publish_clock ? "publishing /clock"
+                                     : (parameters_.follow_clock ? "following /clock" : "not publishing /clock"),
+           recorder_ ? ", recording to " : "", recorder_ ? recorder_->path().c_str() : "");
 }
 
 CartSimNode::~CartSimNode() = default;
@@ -214,6 +233,11 @@ int CartSimNode::run_loop(std::string& outcome) {
     // in real-time mode the node sleeps until a step is due.
     const double instant = start + static_cast<double>(next_publish_index_) * publish_period_;
     const double half_step = 0.5 * simulation_->step_size();
+    if (parameters_.follow_clock) {  // the batch runs once the leader's /clock has reached its end
+      const std::uint64_t resets_before = resets_;
+      wait_for_clock(std::min(instant, end_time_));
+      if (paused_ || record_failure_ || stop_requested() || resets_ != resets_before) continue;
+    }
     Clock::time_point batch_start = Clock::now();
     bool failed = false;
     bool interrupted = false;

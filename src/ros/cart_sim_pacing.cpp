@@ -105,4 +105,14 @@ void CartSimNode::wait_for_commands(double time) {
   if (pacing_.paced()) pacing_.restart(Clock::now(), simulation_->state().time);
 }
 
+void CartSimNode::wait_for_clock(double time) {
+  // ros::Time::now() is the /clock of the node that drives it (roscpp hears /clock on its own
+  // thread). 1 µs allows for the nanosecond rounding of ROS time.
+  constexpr double kStampRounding = 1e-6;  // [s]
+  while (ros::Time::now().toSec() < time - kStampRounding && !stop_requested() && !paused_) {
+    callback_queue_.wait_until(after(0.01));
+    process_callbacks();
+  }
+}
+
 }  // namespace birkhoff_cart

@@ -44,6 +44,29 @@ void require(bool condition, const std::string& message) {
   if (!condition) throw std::invalid_argument(message);
 }
 
+// Six variances [x, y, z, roll, pitch, yaw] (ros_controllers' *_covariance_diagonal), each finite
+// and >= 0 [m², rad² or (m/s)², (rad/s)²].
+std::array<double, 6> read_variances(const ros::NodeHandle& node, const std::string& name,
+                                     const std::array<double, 6>& fallback) {
+  XmlRpc::XmlRpcValue value;
+  if (!node.getParam(name, value)) return fallback;
+  const std::string rule = "parameter " + node.resolveName(name) +
+                           " must be a list of 6 variances >= 0 (x, y, z, roll, pitch, yaw)";
+  if (value.getType() != XmlRpc::XmlRpcValue::TypeArray || value.size() != 6) throw std::invalid_argument(rule);
+  std::array<double, 6> variances{};
+  for (int i = 0; i < 6; ++i) {
+    if (value[i].getType() == XmlRpc::XmlRpcValue::TypeDouble) {
+      variances[i] = static_cast<double>(value[i]);
+    } else if (value[i].getType() == XmlRpc::XmlRpcValue::TypeInt) {
+      variances[i] = static_cast<int>(value[i]);
+    } else {
+      throw std::invalid_argument(rule);
+    }
+    if (!std::isfinite(variances[i]) || variances[i] < 0.0) throw std::invalid_argument(rule);
+  }
+  return variances;
+}
+
 }  // namespace
 
 std::string format_seconds(double value) {
@@ -74,10 +97,10 @@ CartSimParameters load_parameters(const ros::NodeHandle& private_node) {
           "~command_timeout must be >= 0 s (0 = no watchdog)");
   parameters.max_steering_torque = read_double(p, "max_steering_torque", parameters.max_steering_torque);
   require(std::isfinite(parameters.max_steering_torque) && parameters.max_steering_torque > 0.0,
-          "~max_steering_torque must be > 0 N·m");
+          "~max_steering_torque must be > 0 N m");
   parameters.max_drive_torque = read_double(p, "max_drive_torque", parameters.max_drive_torque);
   require(std::isfinite(parameters.max_drive_torque) && parameters.max_drive_torque > 0.0,
-          "~max_drive_torque must be > 0 N·m");
+          "~max_drive_torque must be > 0 N m");
   parameters.lockstep = read_parameter<bool>(p, "lockstep", parameters.lockstep);
   parameters.lockstep_topics_given = p.hasParam("lockstep_topics");
   parameters.lockstep_topics = read_parameter<std::vector<std::string>>(p, "lockstep_topics", parameters.lockstep_topics);
@@ -99,10 +122,20 @@ CartSimParameters load_parameters(const ros::NodeHandle& private_node) {
           "~min_free_disk_space must be >= 0 bytes (0 = no check)");
   parameters.min_free_disk_space = static_cast<std::uint64_t>(min_free_disk_space);
   parameters.summary_path = read_parameter<std::string>(p, "summary_path", parameters.summary_path);
-  parameters.frames.odom = read_parameter<std::string>(p, "odom_frame", parameters.frames.odom);
-  parameters.frames.base_link = read_parameter<std::string>(p, "base_frame", parameters.frames.base_link);
+  parameters.frame_prefix = read_parameter<std::string>(p, "frame_prefix", parameters.frame_prefix);
+  parameters.frames = ros_conversions::prefixed_frames(
+      parameters.frame_prefix, read_parameter<std::string>(p, "odom_frame", parameters.frames.odom),
+      read_parameter<std::string>(p, "base_frame", parameters.frames.base_link));
+  require(parameters.frames.odom != parameters.frames.base_link, "~odom_frame and ~base_frame must differ");
+  parameters.odometry_covariance.pose_diagonal =
+      read_variances(p, "pose_covariance_diagonal", parameters.odometry_covariance.pose_diagonal);
+  parameters.odometry_covariance.twist_diagonal =
+      read_variances(p, "twist_covariance_diagonal", parameters.odometry_covariance.twist_diagonal);
   parameters.publish_tf = read_parameter<bool>(p, "publish_tf", parameters.publish_tf);
   parameters.publish_clock = read_parameter<bool>(p, "publish_clock", parameters.publish_clock);
+  parameters.follow_clock = read_parameter<bool>(p, "follow_clock", parameters.follow_clock);
+  require(!(parameters.follow_clock && parameters.publish_clock),
+          "~follow_clock needs ~publish_clock false: a node cannot follow the clock it drives itself");
   parameters.start_paused = read_parameter<bool>(p, "start_paused", parameters.start_paused);
   parameters.diagnostic_period = read_double(p, "diagnostic_period", parameters.diagnostic_period);
   require(std::isfinite(parameters.diagnostic_period) && parameters.diagnostic_period > 0.0,
@@ -117,7 +150,7 @@ CartSimParameters load_parameters(const ros::NodeHandle& private_node) {
   require(parameters.energy_residual_warn > 0.0 && parameters.energy_residual_warn <= parameters.energy_residual_error,
           "~energy_residual_warn must be > 0 and <= ~energy_residual_error [J]");
   require(parameters.p2_residual_warn > 0.0 && parameters.p2_residual_warn <= parameters.p2_residual_error,
-          "~p2_residual_warn must be > 0 and <= ~p2_residual_error [N·m·s]");
+          "~p2_residual_warn must be > 0 and <= ~p2_residual_error [N m s]");
   require(parameters.constraint_residual_warn > 0.0 &&
               parameters.constraint_residual_warn <= parameters.constraint_residual_error,
           "~constraint_residual_warn must be > 0 and <= ~constraint_residual_error [m/s]");

@@ -2,6 +2,7 @@
 #include "birkhoff_cart/ros/cart_sim_node.h"
 
 #include <rosgraph_msgs/Clock.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include "birkhoff_cart/ros/accuracy_reporting.h"
 #include "birkhoff_cart/ros/instant_schedule.h"
@@ -21,9 +22,10 @@ void CartSimNode::publish_clock(double time) {
 void CartSimNode::publish_instant() {
   const CartState& state = simulation_->state();
   const CartModel& model = simulation_->model();
-  const nav_msgs::Odometry odometry = ros_conversions::to_odometry(state, model, parameters_.frames);
-  const sensor_msgs::JointState joints =
-      ros_conversions::to_joint_state(state, model, ros_conversions::actuator_efforts(*simulation_));
+  const nav_msgs::Odometry odometry =
+      ros_conversions::to_odometry(state, model, parameters_.frames, parameters_.odometry_covariance);
+  const sensor_msgs::JointState joints = ros_conversions::to_joint_state(
+      state, model, ros_conversions::actuator_efforts(*simulation_), parameters_.frames.joint_prefix);
   last_wall_time_per_step_ = period_steps_ > 0 ? period_stepping_wall_time_ / static_cast<double>(period_steps_) : 0.0;
   period_stepping_wall_time_ = 0.0;
   period_steps_ = 0;
@@ -37,8 +39,11 @@ void CartSimNode::publish_instant() {
   odometry_publisher_.publish(odometry);
   joint_state_publisher_.publish(joints);
   integration_error_publisher_.publish(error);
-  if (transform_broadcaster_ && odometry.header.stamp != last_transform_stamp_) {
-    transform_broadcaster_->sendTransform(ros_conversions::to_transform(state, model, parameters_.frames));
+  // odom → base_link, once per stamp; also into the bag, so a replay in rviz places the cart.
+  tf2_msgs::TFMessage transforms;
+  if (parameters_.publish_tf && odometry.header.stamp != last_transform_stamp_) {
+    transforms.transforms.push_back(ros_conversions::to_transform(state, model, parameters_.frames));
+    transform_broadcaster_->sendTransform(transforms.transforms.front());
     last_transform_stamp_ = odometry.header.stamp;
   }
   ++published_instants_;
@@ -48,6 +53,7 @@ void CartSimNode::publish_instant() {
       recorder_->write(integration_error_publisher_.getTopic(), error.header.stamp, error);
       recorder_->write(odometry_publisher_.getTopic(), odometry.header.stamp, odometry);
       recorder_->write(joint_state_publisher_.getTopic(), joints.header.stamp, joints);
+      if (!transforms.transforms.empty()) recorder_->write("/tf", odometry.header.stamp, transforms);
     } catch (const std::exception& failure) {
       record_failure_ = failure.what();
     }

@@ -13,7 +13,7 @@ void CartSimNode::receive_command(CommandChannel& channel, const std::string& to
     ROS_ERROR_THROTTLE(1.0, "cart_sim: rejected non-finite %s command (%g) at t = %.6g s (%lu rejected so far)",
                        topic.c_str(), message.data, time, static_cast<unsigned long>(channel.rejected()));
   } else if (outcome == CommandChannel::Outcome::kClamped) {
-    ROS_WARN_THROTTLE(1.0, "cart_sim: %s command %g clamped to %g N·m", topic.c_str(), message.data,
+    ROS_WARN_THROTTLE(1.0, "cart_sim: %s command %g clamped to %g N m", topic.c_str(), message.data,
                       channel.torque());
   }
   if (steering_channel_ && &channel == &*steering_channel_) steering_answered_ = true;

@@ -68,8 +68,9 @@ TEST(NodeBag, RecordHasTopicsCountsAndCompression) {
   EXPECT_EQ(counts["/cart_sim/integration_error"], expected);
   EXPECT_EQ(counts["/odom"], expected);
   EXPECT_EQ(counts["/joint_states"], expected);
+  EXPECT_EQ(counts["/tf"], expected) << "odom -> base_link, so a replay in rviz places the cart";
   EXPECT_EQ(counts["/steering_torque"], 3);
-  EXPECT_EQ(counts.size(), 4u);
+  EXPECT_EQ(counts.size(), 5u);
 
   // Integration errors are stamped with scene time and carry the run's settings.
   rosbag::Bag bag(bag_path, rosbag::bagmode::Read);

@@ -112,6 +112,9 @@ class CartSimNode {
 
   // cart_sim_summary.cpp
   void produce_diagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
+  /// ~follow_clock: waits until the /clock another node drives reaches scene time `time` [s] (the
+  /// end of the next batch of steps), so this cart's stamps are instants of that clock, never ahead.
+  void wait_for_clock(double time);
   void write_summary(const std::string& outcome);
   /// Real-time factor over the run: scene time advanced / wall time not paused [-].
   double real_time_factor() const;

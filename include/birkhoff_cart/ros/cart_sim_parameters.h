@@ -33,9 +33,12 @@ struct CartSimParameters {
   std::string bag_compression = "lz4";       ///< ~bag_compression: lz4, bz2 or none
   std::uint64_t min_free_disk_space = 16u << 20;  ///< ~min_free_disk_space: refuse to record below [bytes]; 0 = no check
   std::string summary_path;                  ///< ~summary_path: also write the final summary here; "" = no file
-  ros_conversions::FrameNames frames;        ///< ~odom_frame, ~base_frame
+  std::string frame_prefix;                  ///< ~frame_prefix: before every frame and joint name ("cart1/")
+  ros_conversions::FrameNames frames;        ///< ~frame_prefix + ~odom_frame, ~frame_prefix + ~base_frame
+  ros_conversions::OdometryCovariance odometry_covariance;  ///< ~pose/twist_covariance_diagonal
   bool publish_tf = true;                    ///< ~publish_tf: odom → base_link on /tf
   bool publish_clock = true;                 ///< ~publish_clock: the node drives /clock
+  bool follow_clock = false;                 ///< ~follow_clock: step only up to another node's /clock
   bool start_paused = false;                 ///< ~start_paused: wait for ~pause(false) before stepping
   double diagnostic_period = 1.0;            ///< ~diagnostic_period: /diagnostics every [s of scene time]
   double energy_residual_warn = 1e-4;        ///< ~energy_residual_warn: |T* − T*₀ − W| [J]

@@ -1,0 +1,149 @@
+// rostest two_carts: two cart_sim nodes under one master, in namespaces cart1 and cart2 with frame
+// prefixes cart1/ and cart2/, and one /clock (cart1's; cart2's cart_sim follows it). For each cart:
+// odom, joint_states and the tf tree (cartN/odom → cartN/base_link from cart_sim, the links from its
+// robot_state_publisher) carry its own prefix, and its odometry agrees with a core Simulation of its
+// own scene at every stamp; the two trees share no frame; /clock has one publisher and never goes
+// back.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+#include <rosgraph_msgs/Clock.h>
+#include <sensor_msgs/JointState.h>
+#include <tf2/utils.h>
+#include <tf2_ros/transform_listener.h>
+
+#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/ros/conversions.h"
+#include "test_helpers.h"
+
+namespace {
+
+constexpr double kPositionTolerance = 1e-9;  // [m]
+constexpr double kAngleTolerance = 1e-9;     // [rad]
+constexpr double kStampTolerance = 1e-9;     // [s]
+constexpr double kWaitTimeout = 60.0;        // [s of wall time], only against hangs
+constexpr double kDuration = 2.0;            // the span checked, from both carts' start [s]
+constexpr double kPublishRate = 50.0;        // both carts' ~publish_rate [Hz]
+
+/// What one cart publishes, collected by topic.
+struct CartRecord {
+  std::string name;  // cart1, cart2
+  std::vector<nav_msgs::Odometry> odometry;
+  std::vector<sensor_msgs::JointState> joints;
+  ros::Subscriber odometry_subscriber;
+  ros::Subscriber joint_subscriber;
+};
+
+void listen(ros::NodeHandle& node, CartRecord& cart) {
+  cart.odometry_subscriber = node.subscribe<nav_msgs::Odometry>(
+      "/" + cart.name + "/odom", 1000, [&cart](const nav_msgs::Odometry::ConstPtr& m) { cart.odometry.push_back(*m); });
+  cart.joint_subscriber = node.subscribe<sensor_msgs::JointState>(
+      "/" + cart.name + "/joint_states", 1000,
+      [&cart](const sensor_msgs::JointState::ConstPtr& m) { cart.joints.push_back(*m); });
+}
+
+void check_cart(const CartRecord& cart, const std::string& scene_path, const tf2_ros::Buffer& buffer) {
+  SCOPED_TRACE(cart.name);
+  const std::string prefix = cart.name + "/";
+  const std::size_t expected = static_cast<std::size_t>(std::llround(kDuration * kPublishRate));
+  ASSERT_GE(cart.odometry.size(), expected);
+  ASSERT_GE(cart.joints.size(), expected);
+  birkhoff_cart::Simulation simulation(birkhoff_cart::load_scene(scene_path));
+  const double start_time = simulation.state().time;
+  for (std::size_t k = 0; k < expected; ++k) {
+    const nav_msgs::Odometry& odom = cart.odometry[k];
+    const double stamp = odom.header.stamp.toSec();
+    SCOPED_TRACE("instant " + std::to_string(k) + " at t = " + std::to_string(stamp));
+    EXPECT_NEAR(stamp, start_time + static_cast<double>(k + 1) / kPublishRate, kStampTolerance);
+    EXPECT_EQ(odom.header.frame_id, prefix + "odom");
+    EXPECT_EQ(odom.child_frame_id, prefix + "base_link");
+    simulation.advance_to(stamp);
+    const Eigen::Vector2d rear_axle_midpoint = simulation.model().rear_axle_midpoint(simulation.state());
+    EXPECT_NEAR(odom.pose.pose.position.x, rear_axle_midpoint.x(), kPositionTolerance);
+    EXPECT_NEAR(odom.pose.pose.position.y, rear_axle_midpoint.y(), kPositionTolerance);
+    EXPECT_NEAR(std::remainder(tf2::getYaw(odom.pose.pose.orientation) - simulation.state().heading, 2.0 * M_PI), 0.0,
+                kAngleTolerance);
+    // cart_sim's own transform, found under the cart's prefix at this stamp
+    geometry_msgs::TransformStamped transform;
+    ASSERT_NO_THROW(transform = buffer.lookupTransform(prefix + "odom", prefix + "base_link", odom.header.stamp));
+    EXPECT_NEAR(transform.transform.translation.x, odom.pose.pose.position.x, kPositionTolerance);
+    EXPECT_NEAR(transform.transform.translation.y, odom.pose.pose.position.y, kPositionTolerance);
+  }
+  const auto& names = birkhoff_cart::ros_conversions::joint_names();
+  ASSERT_EQ(cart.joints[expected - 1].name.size(), names.size());
+  for (std::size_t j = 0; j < names.size(); ++j) EXPECT_EQ(cart.joints[expected - 1].name[j], prefix + names[j]);
+  // The whole tree: robot_state_publisher (fed the prefixed URDF and these joint_states) hangs the
+  // links under cartN/base_link, so a wheel resolves in cartN/odom.
+  const ros::Time last = cart.odometry[expected - 1].header.stamp;
+  std::string error;
+  for (const char* link : {"rear_body", "front_axle", "front_left_wheel", "rear_right_wheel"}) {
+    EXPECT_TRUE(buffer.canTransform(prefix + "odom", prefix + link, last, &error)) << link << ": " << error;
+  }
+}
+
+TEST(TwoCarts, EachCartHasItsOwnTreeAndOdometryUnderOneClock) {
+  ros::NodeHandle node;
+  ros::NodeHandle private_node("~");
+  std::string cart1_scene, cart2_scene;
+  ASSERT_TRUE(private_node.getParam("cart1_scene", cart1_scene));
+  ASSERT_TRUE(private_node.getParam("cart2_scene", cart2_scene));
+  CartRecord cart1{"cart1"}, cart2{"cart2"};
+  listen(node, cart1);
+  listen(node, cart2);
+  std::vector<ros::Time> clocks;
+  auto clock_subscriber = node.subscribe<rosgraph_msgs::Clock>(
+      "/clock", 1000, [&](const rosgraph_msgs::Clock::ConstPtr& m) { clocks.push_back(m->clock); });
+  tf2_ros::Buffer buffer(ros::Duration(60.0));
+  tf2_ros::TransformListener listener(buffer);
+
+  ASSERT_TRUE(birkhoff_cart_test::wait_for(
+      [&] {
+        return cart1.odometry_subscriber.getNumPublishers() > 0 && cart2.odometry_subscriber.getNumPublishers() > 0 &&
+               clock_subscriber.getNumPublishers() > 0;
+      },
+      kWaitTimeout));
+  ros::WallDuration(0.5).sleep();  // a second /clock publisher, if any, would have connected by now
+  ros::spinOnce();
+  EXPECT_EQ(clock_subscriber.getNumPublishers(), 1u) << "one node drives /clock";
+  // cart2 first: it waits for a /clock that only cart1 publishes.
+  ASSERT_TRUE(birkhoff_cart_test::set_paused("/cart2/cart_sim/pause", false));
+  ASSERT_TRUE(birkhoff_cart_test::set_paused("/cart1/cart_sim/pause", false));
+  const std::size_t expected = static_cast<std::size_t>(std::llround(kDuration * kPublishRate));
+  ASSERT_TRUE(birkhoff_cart_test::wait_for(
+      [&] { return cart1.odometry.size() >= expected && cart2.odometry.size() >= expected; }, kWaitTimeout))
+      << cart1.odometry.size() << " and " << cart2.odometry.size() << " odom of " << expected;
+  ASSERT_TRUE(birkhoff_cart_test::wait_for(
+      [&] { return cart1.joints.size() >= expected && cart2.joints.size() >= expected; }, kWaitTimeout));
+  // The robot_state_publishers' transforms of the last checked instant: the carts run on, so
+  // wait until a later instant has come from both.
+  ASSERT_TRUE(birkhoff_cart_test::wait_for(
+      [&] { return cart1.odometry.size() >= expected + 10 && cart2.odometry.size() >= expected + 10; }, kWaitTimeout));
+
+  ASSERT_FALSE(clocks.empty());
+  for (std::size_t i = 1; i < clocks.size(); ++i) EXPECT_GT(clocks[i], clocks[i - 1]) << "/clock went back";
+
+  check_cart(cart1, cart1_scene, buffer);
+  check_cart(cart2, cart2_scene, buffer);
+  // Two trees, no shared frame.
+  EXPECT_FALSE(buffer.canTransform("cart1/odom", "cart2/odom", ros::Time(0)));
+  EXPECT_FALSE(buffer._frameExists("odom")) << "an unprefixed frame leaked";
+  EXPECT_FALSE(buffer._frameExists("base_link")) << "an unprefixed frame leaked";
+  // The carts really moved apart from rest.
+  EXPECT_GT(std::abs(cart2.odometry[expected - 1].pose.pose.position.x - cart2.odometry.front().pose.pose.position.x),
+            1.0);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "two_carts_test");
+  ros::NodeHandle node;
+  return RUN_ALL_TESTS();
+}
