@@ -147,14 +147,19 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
     clock_subscriber_ = clock_node.subscribe("/clock", 1, &hear_clock);
   }
   if (parameters_.publish_tf) transform_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
-  // Subscriptions exist for every scene, so a command for an effect without a command source is
-  // counted and reported instead of vanishing.
+  // Only the commands the scene takes are subscribed: an idle subscription would be an unconnected
+  // one for roswtf, and a command sent to a scene without a command source shows up there as an
+  // unconnected publication instead.
   // tcpNoDelay: a command is one small message; Nagle's algorithm would hold it back (lockstep
   // waits for it every publish instant).
-  steering_subscriber_ = node_.subscribe("steering_torque", 20, &CartSimNode::on_steering_torque, this,
-                                         ros::TransportHints().tcpNoDelay());
-  drive_subscriber_ = node_.subscribe("drive_torque", 20, &CartSimNode::on_drive_torque, this,
-                                      ros::TransportHints().tcpNoDelay());
+  if (steering_channel_) {
+    steering_subscriber_ = node_.subscribe("steering_torque", 20, &CartSimNode::on_steering_torque, this,
+                                           ros::TransportHints().tcpNoDelay());
+  }
+  if (drive_channel_) {
+    drive_subscriber_ = node_.subscribe("drive_torque", 20, &CartSimNode::on_drive_torque, this,
+                                        ros::TransportHints().tcpNoDelay());
+  }
   reset_service_ = private_node_.advertiseService("reset", &CartSimNode::on_reset, this);
   pause_service_ = private_node_.advertiseService("pause", &CartSimNode::on_pause, this);
 
