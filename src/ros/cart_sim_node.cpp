@@ -295,6 +295,7 @@ int CartSimNode::run_loop(std::string& outcome) {
       publish_instant();
       if (record_failure_) break;
       if (parameters_.lockstep) wait_for_commands(time);
+      if (parameters_.fast) report_progress();
     }
   }
   return 0;

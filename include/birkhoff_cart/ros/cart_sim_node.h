@@ -115,6 +115,9 @@ class CartSimNode {
   /// ~follow_clock: waits until the /clock another node drives reaches scene time `time` [s] (the
   /// end of the next batch of steps), so this cart's stamps are instants of that clock, never ahead.
   void wait_for_clock(double time);
+  /// Fast mode: at most once per second of wall time, one log line with the scene time, the percent
+  /// of the run done and the real-time factor since the last line.
+  void report_progress();
   void write_summary(const std::string& outcome);
   /// Real-time factor over the run: scene time advanced / wall time not paused [-].
   double real_time_factor() const;
@@ -164,6 +167,8 @@ class CartSimNode {
 
   // Work measurement (wall clock) for integration_error, diagnostics and the summary.
   WallClockPacing::Clock::time_point run_start_wall_;
+  std::optional<WallClockPacing::Clock::time_point> last_progress_wall_;  ///< the last progress line (or the start)
+  double last_progress_time_ = 0.0;           ///< the scene time it reported then [s]
   double paused_wall_time_ = 0.0;             ///< wall time spent paused [s]
   double stepping_wall_time_ = 0.0;           ///< wall time spent in step batches since the start [s]
   double period_stepping_wall_time_ = 0.0;    ///< ... since the last publish instant [s]
