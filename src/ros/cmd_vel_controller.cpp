@@ -142,14 +142,17 @@ ActuatorCommand CmdVelController::update(const CartFeedback& feedback) {
                            s.steering_d * (steering_reference_rate_ - feedback.steering_rate);
   output.steering_torque = std::clamp(output.steering_torque, -s.max_steering_torque, s.max_steering_torque);
 
-  // 6. T = k_ff v̇_ref + k_p,v e + k_i,v ∫e dt, e = v_ref − v_A [m/s]; the integral stops growing
-  //    while T saturates.
+  // 6. T = k_ff v̇_ref + k_p,v e + k_i,v ∫e dt, e = v_ref − v_A [m/s]. The integral is for a steady
+  //    load (rolling resistance, drag): it grows only while v_ref is steady (a ramp's tracking lag
+  //    would wind it up and leave a slow creep after the ramp) and T is not saturated.
   const double speed_error = speed_reference_ - feedback.base_speed;
   const double proportional = s.drive_ff * speed_reference_rate_ + s.drive_p * speed_error;
   const double candidate_integral =
       std::clamp(speed_integral_ + s.drive_i * speed_error * dt, -s.drive_i_clamp, s.drive_i_clamp);
   const double unclamped = proportional + candidate_integral;
-  if (std::abs(unclamped) <= s.max_drive_torque || std::abs(candidate_integral) < std::abs(speed_integral_)) {
+  const bool reference_steady = speed_reference_rate_ == 0.0;
+  if ((reference_steady && std::abs(unclamped) <= s.max_drive_torque) ||
+      std::abs(candidate_integral) < std::abs(speed_integral_)) {
     speed_integral_ = candidate_integral;
   }
   output.drive_torque = std::clamp(proportional + speed_integral_, -s.max_drive_torque, s.max_drive_torque);

@@ -14,6 +14,7 @@
 #include <geometry_msgs/Twist.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include <std_msgs/Float64.h>
 #include <tf2/utils.h>
 
 #include "test_helpers.h"
@@ -62,6 +63,8 @@ class CmdVelFigureEight : public testing::Test {
       if (on_sample_) on_sample_(latest_);
     });
     cmd_vel_publisher_ = node_.advertise<geometry_msgs::Twist>("cmd_vel", 10);
+    torque_subscriber_ = node_.subscribe<std_msgs::Float64>(
+        "drive_torque", 100, [this](const std_msgs::Float64::ConstPtr&) { ++torques_seen_; });
     ASSERT_TRUE(birkhoff_cart_test::wait_for(
         [this] { return odometry_subscriber_.getNumPublishers() > 0 && cmd_vel_publisher_.getNumSubscribers() > 0; },
         kWaitTimeout));
@@ -107,6 +110,8 @@ class CmdVelFigureEight : public testing::Test {
   ros::NodeHandle node_;
   ros::Subscriber odometry_subscriber_;
   ros::Publisher cmd_vel_publisher_;
+  ros::Subscriber torque_subscriber_;
+  long torques_seen_ = 0;  // drive_torque messages of the controller
   Sample latest_;
   long count_ = 0;
   bool sending_ = false;
@@ -115,8 +120,11 @@ class CmdVelFigureEight : public testing::Test {
 };
 
 TEST_F(CmdVelFigureEight, FollowsTheTwistAndBrakesOnSilence) {
-  // driven.yaml starts at 2 m/s; before any cmd_vel the controller brakes it to rest.
+  // driven.yaml starts at 2 m/s; before any cmd_vel the controller brakes it to rest, from its first
+  // torque on (its subscriptions may connect a little after the test's).
+  ASSERT_TRUE(birkhoff_cart_test::wait_for([this] { return torques_seen_ > 0; }, kWaitTimeout));
   for_scene_time(kBrakeTime);
+  std::printf("braked from the scene's 2 m/s: |v_A| = %.4f m/s after %.1f s\n", std::abs(latest_.speed), kBrakeTime);
   EXPECT_LT(std::abs(latest_.speed), kRestSpeed);
 
   command(kSpeed, 0.0);
@@ -136,6 +144,7 @@ TEST_F(CmdVelFigureEight, FollowsTheTwistAndBrakesOnSilence) {
 
   sending_ = false;  // silence: the controller's cmd_vel_timeout brakes the cart
   for_scene_time(kBrakeTime);
+  std::printf("braked on silence: |v_A| = %.4f m/s after %.1f s\n", std::abs(latest_.speed), kBrakeTime);
   EXPECT_LT(std::abs(latest_.speed), kRestSpeed);
 }
 

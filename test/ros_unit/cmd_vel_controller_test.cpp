@@ -245,6 +245,7 @@ TEST(CmdVelClosedLoop, DrivesAFigureEightAndBrakesOnSilence) {
   ClosedLoop loop;
   // driven.yaml starts at ω1 = 2 m/s: with no command the law brakes the cart to rest.
   loop.drive(0.0, 0.0, 2.0, /*send=*/false);
+  std::printf("braked from 2 m/s: |v_A| = %.2e m/s after 2 s\n", std::abs(loop.base_speed()));
   EXPECT_LT(std::abs(loop.base_speed()), kRestSpeed);
 
   // Up to 1.5 m/s straight, then the figure eight: one full turn left, one right (r = ±0.75 rad/s,
@@ -266,6 +267,7 @@ TEST(CmdVelClosedLoop, DrivesAFigureEightAndBrakesOnSilence) {
 
   // Silence: after cmd_vel_timeout the law brakes to rest.
   loop.drive(0.0, 0.0, 3.0, /*send=*/false);
+  std::printf("braked on silence from 1.5 m/s: |v_A| = %.2e m/s after 3 s\n", std::abs(loop.base_speed()));
   EXPECT_EQ(loop.controller().timeouts(), 1u);
   EXPECT_LT(std::abs(loop.base_speed()), kRestSpeed);
 

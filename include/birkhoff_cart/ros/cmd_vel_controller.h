@@ -15,7 +15,7 @@
 //   4. a reference χ_ref that follows χ* at no more than steering.max_rate;
 //   5. τ = k_p (χ_ref − χ) + k_d (χ̇_ref − χ̇), clamped to ±steering.max_torque  (PD on the hinge);
 //   6. T = k_ff v̇_ref + k_p,v (v_ref − v_A) + k_i,v ∫(v_ref − v_A) dt, clamped to ±drive.max_torque,
-//      the integral clamped to ±drive.i_clamp and frozen while T saturates (anti-windup): a
+//      the integral clamped to ±drive.i_clamp and frozen while v_ref ramps or T saturates: a
 //      feed-forward of the reference's acceleration (k_ff = μ r1, the torque that accelerates the
 //      straight-running cart at 1 m/s², eq. (3.4) at χ = 0 with Q1 = T / r1) and a PI loop.
 // Time is whatever the caller stamps its feedback with (scene time for the node); it never reads
