@@ -25,6 +25,13 @@ def run(command):
                           timeout=RUN_LIMIT, stdin=subprocess.DEVNULL)
 
 
+def plot_bag(*arguments):
+    """plot_bag itself, without rosrun's search of the package (the user's path, through rosrun, is
+    test_plots_a_cart_sim_bag's first call)."""
+    script = os.path.join(rospkg.RosPack().get_path(PACKAGE), "scripts", "plot_bag")
+    return run([script] + list(arguments))
+
+
 def png_size(path):
     """(width, height) from the PNG's IHDR chunk; raises when the file is not a PNG."""
     with open(path, "rb") as png:
@@ -62,13 +69,13 @@ class PlotBag(unittest.TestCase):
         self.assertEqual(png_size(png), (1200, 680))  # 15 x 8.5 in at 80 dpi
 
         other = os.path.join(self.directory, "elsewhere.png")
-        result = run(["rosrun", PACKAGE, "plot_bag", self.bag, "-o", other])
+        result = plot_bag(self.bag, "-o", other)
         self.assertEqual(result.returncode, 0, result.stderr)
         self.assertEqual(png_size(other), (1200, 680))
 
     def test_refuses_a_missing_bag(self):
         missing = os.path.join(self.directory, "missing.bag")
-        result = run(["rosrun", PACKAGE, "plot_bag", missing])
+        result = plot_bag(missing)
         self.assertEqual(result.returncode, 2)
         self.assertIn("no bag at " + missing, result.stderr)
 
@@ -76,7 +83,7 @@ class PlotBag(unittest.TestCase):
         foreign = os.path.join(self.directory, "foreign.bag")
         with rosbag.Bag(foreign, "w") as bag:
             bag.write("/chatter", String(data="hello"), rospy.Time(1.0))
-        result = run(["rosrun", PACKAGE, "plot_bag", foreign])
+        result = plot_bag(foreign)
         self.assertEqual(result.returncode, 2)
         self.assertIn("is it a cart_sim bag?", result.stderr)
         self.assertIn("/chatter", result.stderr)
