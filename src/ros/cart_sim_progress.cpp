@@ -1,4 +1,5 @@
 // cart_sim's progress line in fast mode (see cart_sim_node.h): a long run says how far it is.
+#include <chrono>
 #include <cmath>
 
 #include "birkhoff_cart/ros/cart_sim_node.h"
@@ -7,12 +8,12 @@ namespace birkhoff_cart {
 
 void CartSimNode::report_progress() {
   constexpr double kProgressPeriod = 1.0;  // at most one line per this much wall time [s]
-  const ros::WallTime now = ros::WallTime::now();
-  if (last_progress_wall_.isZero()) {  // the first call of the run: start counting
+  const WallClockPacing::Clock::time_point now = WallClockPacing::Clock::now();
+  if (!last_progress_wall_) {  // the first call of the run: start counting
     last_progress_wall_ = run_start_wall_;
     last_progress_time_ = simulation_->scene().initial_state.time;
   }
-  const double wall_elapsed = (now - last_progress_wall_).toSec();
+  const double wall_elapsed = std::chrono::duration<double>(now - *last_progress_wall_).count();  // [s]
   if (wall_elapsed < kProgressPeriod) return;
   const double time = simulation_->state().time;
   const double start_time = simulation_->scene().initial_state.time;

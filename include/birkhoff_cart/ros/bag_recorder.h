@@ -30,6 +30,7 @@
 #include <rosbag/bag.h>
 #include <sensor_msgs/JointState.h>
 #include <std_msgs/Float64.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include "birkhoff_cart/IntegrationError.h"
 
@@ -62,7 +63,8 @@ class BagRecorder {
  public:
   enum class Compression { kNone, kLz4, kBz2 };
   /// The message types the node records (one slot of the ring holds any of them).
-  using Message = std::variant<nav_msgs::Odometry, sensor_msgs::JointState, IntegrationError, std_msgs::Float64>;
+  using Message =
+      std::variant<nav_msgs::Odometry, sensor_msgs::JointState, IntegrationError, std_msgs::Float64, tf2_msgs::TFMessage>;
   /// Slots of the ring between the time loop and the writer thread [messages].
   static constexpr std::size_t kQueueCapacity = 1024;
 

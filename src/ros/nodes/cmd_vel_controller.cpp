@@ -2,9 +2,11 @@
 // cmd_vel_controller"). All the work is in CmdVelControllerNode and CmdVelController.
 #include <ros/ros.h>
 
+#include "birkhoff_cart/core/version.h"
 #include "birkhoff_cart/ros/cmd_vel_controller_node.h"
 
 int main(int argc, char** argv) {
+  if (birkhoff_cart::print_version_if_asked(argc, argv, "cmd_vel_controller")) return 0;
   ros::init(argc, argv, "cmd_vel_controller");
   ros::NodeHandle node_handle;
   try {

@@ -10,8 +10,10 @@
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 #include <std_msgs/Float64.h>
+#include "birkhoff_cart/core/version.h"
 
 int main(int argc, char** argv) {
+  if (birkhoff_cart::print_version_if_asked(argc, argv, "steering_pd_controller")) return 0;
   ros::init(argc, argv, "steering_pd_controller");
   ros::NodeHandle node;
   ros::NodeHandle private_node("~");
