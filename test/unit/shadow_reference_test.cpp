@@ -104,6 +104,7 @@ TEST(ShadowReference, TinyFixedShadowStepIsRefusedAtLoadInsteadOfOverflowing) {
     }
   }
   Scene scene = load("default");
+  scene.integrator.step_size = 1e-3;  // [s]
   scene.reference.shadow.name = "rk4";
   scene.reference.shadow.step_size = 1e-3 / kMaxShadowSubsteps;  // exactly at the limit
   EXPECT_NO_THROW(Simulation{scene});
