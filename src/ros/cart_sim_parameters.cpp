@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "birkhoff_cart/ros/bag_recorder.h"
+#include "birkhoff_cart/ros/parameter_reading.h"
 
 namespace birkhoff_cart {
 namespace {
@@ -19,25 +20,6 @@ T read_parameter(const ros::NodeHandle& node, const std::string& name, const T& 
     throw std::invalid_argument("parameter " + node.resolveName(name) + " has the wrong type");
   }
   return fallback;
-}
-
-// Doubles may be written as integers on the parameter server (publish_rate: 100).
-double read_double(const ros::NodeHandle& node, const std::string& name, double fallback) {
-  XmlRpc::XmlRpcValue value;
-  if (!node.getParam(name, value)) return fallback;
-  if (value.getType() == XmlRpc::XmlRpcValue::TypeDouble) return static_cast<double>(value);
-  if (value.getType() == XmlRpc::XmlRpcValue::TypeInt) return static_cast<int>(value);
-  if (value.getType() == XmlRpc::XmlRpcValue::TypeString) {
-    // roslaunch <param value="..."/> without a type may arrive as a string ("1e-3", "-1").
-    const std::string text = static_cast<std::string>(value);
-    try {
-      std::size_t used = 0;
-      const double parsed = std::stod(text, &used);
-      if (used == text.size()) return parsed;
-    } catch (const std::exception&) {
-    }
-  }
-  throw std::invalid_argument("parameter " + node.resolveName(name) + " must be a number");
 }
 
 void require(bool condition, const std::string& message) {
@@ -81,24 +63,24 @@ CartSimParameters load_parameters(const ros::NodeHandle& private_node) {
   parameters.scene_path = read_parameter<std::string>(p, "scene", "");
   require(!parameters.scene_path.empty(), "parameter " + p.resolveName("scene") + " (scene YAML path) is required");
   parameters.integrator = read_parameter<std::string>(p, "integrator", parameters.integrator);
-  parameters.step_size = read_double(p, "step_size", parameters.step_size);
+  parameters.step_size = read_double_parameter(p, "step_size", parameters.step_size);
   require(std::isfinite(parameters.step_size) && parameters.step_size >= 0.0,
           "~step_size must be >= 0 s (0 = the scene's)");
-  parameters.publish_rate = read_double(p, "publish_rate", parameters.publish_rate);
+  parameters.publish_rate = read_double_parameter(p, "publish_rate", parameters.publish_rate);
   require(std::isfinite(parameters.publish_rate) && parameters.publish_rate > 0.0, "~publish_rate must be > 0 Hz");
   parameters.fast = read_parameter<bool>(p, "fast", parameters.fast);
-  parameters.real_time_factor = read_double(p, "real_time_factor", parameters.real_time_factor);
+  parameters.real_time_factor = read_double_parameter(p, "real_time_factor", parameters.real_time_factor);
   require(std::isfinite(parameters.real_time_factor) && parameters.real_time_factor >= 0.0,
           "~real_time_factor must be >= 0 (0 = unlimited in fast mode, 1 in real-time mode)");
-  parameters.duration = read_double(p, "duration", parameters.duration);
+  parameters.duration = read_double_parameter(p, "duration", parameters.duration);
   require(!std::isnan(parameters.duration), "~duration must be a number of seconds");
-  parameters.command_timeout = read_double(p, "command_timeout", parameters.command_timeout);
+  parameters.command_timeout = read_double_parameter(p, "command_timeout", parameters.command_timeout);
   require(std::isfinite(parameters.command_timeout) && parameters.command_timeout >= 0.0,
           "~command_timeout must be >= 0 s (0 = no watchdog)");
-  parameters.max_steering_torque = read_double(p, "max_steering_torque", parameters.max_steering_torque);
+  parameters.max_steering_torque = read_double_parameter(p, "max_steering_torque", parameters.max_steering_torque);
   require(std::isfinite(parameters.max_steering_torque) && parameters.max_steering_torque > 0.0,
           "~max_steering_torque must be > 0 N m");
-  parameters.max_drive_torque = read_double(p, "max_drive_torque", parameters.max_drive_torque);
+  parameters.max_drive_torque = read_double_parameter(p, "max_drive_torque", parameters.max_drive_torque);
   require(std::isfinite(parameters.max_drive_torque) && parameters.max_drive_torque > 0.0,
           "~max_drive_torque must be > 0 N m");
   parameters.lockstep = read_parameter<bool>(p, "lockstep", parameters.lockstep);
@@ -108,7 +90,7 @@ CartSimParameters load_parameters(const ros::NodeHandle& private_node) {
     require(topic == "steering_torque" || topic == "drive_torque",
             "~lockstep_topics may hold only steering_torque and drive_torque, got '" + topic + "'");
   }
-  parameters.lockstep_timeout = read_double(p, "lockstep_timeout", parameters.lockstep_timeout);
+  parameters.lockstep_timeout = read_double_parameter(p, "lockstep_timeout", parameters.lockstep_timeout);
   require(std::isfinite(parameters.lockstep_timeout) && parameters.lockstep_timeout > 0.0,
           "~lockstep_timeout must be > 0 s of wall time");
   parameters.bag_path = read_parameter<std::string>(p, "bag_path", parameters.bag_path);
@@ -117,7 +99,7 @@ CartSimParameters load_parameters(const ros::NodeHandle& private_node) {
   BagRecorder::parse_compression(parameters.bag_compression);  // throws naming the bad value
   // [bytes]; read as a number so sizes beyond a 32-bit XmlRpc int (2 GiB) can be given as 1.6e10.
   const double min_free_disk_space =
-      read_double(p, "min_free_disk_space", static_cast<double>(parameters.min_free_disk_space));
+      read_double_parameter(p, "min_free_disk_space", static_cast<double>(parameters.min_free_disk_space));
   require(std::isfinite(min_free_disk_space) && min_free_disk_space >= 0.0 && min_free_disk_space < 1.8e19,
           "~min_free_disk_space must be >= 0 bytes (0 = no check)");
   parameters.min_free_disk_space = static_cast<std::uint64_t>(min_free_disk_space);
@@ -137,16 +119,16 @@ CartSimParameters load_parameters(const ros::NodeHandle& private_node) {
   require(!(parameters.follow_clock && parameters.publish_clock),
           "~follow_clock needs ~publish_clock false: a node cannot follow the clock it drives itself");
   parameters.start_paused = read_parameter<bool>(p, "start_paused", parameters.start_paused);
-  parameters.diagnostic_period = read_double(p, "diagnostic_period", parameters.diagnostic_period);
+  parameters.diagnostic_period = read_double_parameter(p, "diagnostic_period", parameters.diagnostic_period);
   require(std::isfinite(parameters.diagnostic_period) && parameters.diagnostic_period > 0.0,
           "~diagnostic_period must be > 0 s");
-  parameters.energy_residual_warn = read_double(p, "energy_residual_warn", parameters.energy_residual_warn);
-  parameters.energy_residual_error = read_double(p, "energy_residual_error", parameters.energy_residual_error);
-  parameters.p2_residual_warn = read_double(p, "p2_residual_warn", parameters.p2_residual_warn);
-  parameters.p2_residual_error = read_double(p, "p2_residual_error", parameters.p2_residual_error);
-  parameters.constraint_residual_warn = read_double(p, "constraint_residual_warn", parameters.constraint_residual_warn);
+  parameters.energy_residual_warn = read_double_parameter(p, "energy_residual_warn", parameters.energy_residual_warn);
+  parameters.energy_residual_error = read_double_parameter(p, "energy_residual_error", parameters.energy_residual_error);
+  parameters.p2_residual_warn = read_double_parameter(p, "p2_residual_warn", parameters.p2_residual_warn);
+  parameters.p2_residual_error = read_double_parameter(p, "p2_residual_error", parameters.p2_residual_error);
+  parameters.constraint_residual_warn = read_double_parameter(p, "constraint_residual_warn", parameters.constraint_residual_warn);
   parameters.constraint_residual_error =
-      read_double(p, "constraint_residual_error", parameters.constraint_residual_error);
+      read_double_parameter(p, "constraint_residual_error", parameters.constraint_residual_error);
   require(parameters.energy_residual_warn > 0.0 && parameters.energy_residual_warn <= parameters.energy_residual_error,
           "~energy_residual_warn must be > 0 and <= ~energy_residual_error [J]");
   require(parameters.p2_residual_warn > 0.0 && parameters.p2_residual_warn <= parameters.p2_residual_error,

@@ -7,27 +7,10 @@
 
 #include <std_msgs/Float64.h>
 
+#include "birkhoff_cart/ros/parameter_reading.h"
+
 namespace birkhoff_cart {
 namespace {
-
-// Doubles may be written as integers (max_torque: 50) or, from roslaunch <param> without a type,
-// as strings ("1e-3").
-double read_double(const ros::NodeHandle& node, const std::string& name, double fallback) {
-  XmlRpc::XmlRpcValue value;
-  if (!node.getParam(name, value)) return fallback;
-  if (value.getType() == XmlRpc::XmlRpcValue::TypeDouble) return static_cast<double>(value);
-  if (value.getType() == XmlRpc::XmlRpcValue::TypeInt) return static_cast<int>(value);
-  if (value.getType() == XmlRpc::XmlRpcValue::TypeString) {
-    const std::string text = static_cast<std::string>(value);
-    try {
-      std::size_t used = 0;
-      const double parsed = std::stod(text, &used);
-      if (used == text.size()) return parsed;
-    } catch (const std::exception&) {
-    }
-  }
-  throw std::invalid_argument("parameter " + node.resolveName(name) + " must be a number");
-}
 
 // ros_controllers' has_*_limits switches: false lifts the limit (to ±∞ for values; very large for
 // rates, which must stay finite).
@@ -46,35 +29,35 @@ constexpr double kNoLimit = 1e9;  // stands for "unlimited" in a finite-limit sl
 
 CmdVelControllerSettings load_cmd_vel_controller_settings(const ros::NodeHandle& p) {
   CmdVelControllerSettings s;
-  s.wheel_separation_h = read_double(p, "wheel_separation_h", s.wheel_separation_h);
-  s.cmd_vel_timeout = read_double(p, "cmd_vel_timeout", s.cmd_vel_timeout);
-  s.zero_speed = read_double(p, "zero_speed", s.zero_speed);
-  s.max_velocity = read_double(p, "linear/x/max_velocity", s.max_velocity);
-  s.min_velocity = read_double(p, "linear/x/min_velocity", s.min_velocity);
+  s.wheel_separation_h = read_double_parameter(p, "wheel_separation_h", s.wheel_separation_h);
+  s.cmd_vel_timeout = read_double_parameter(p, "cmd_vel_timeout", s.cmd_vel_timeout);
+  s.zero_speed = read_double_parameter(p, "zero_speed", s.zero_speed);
+  s.max_velocity = read_double_parameter(p, "linear/x/max_velocity", s.max_velocity);
+  s.min_velocity = read_double_parameter(p, "linear/x/min_velocity", s.min_velocity);
   if (!read_switch(p, "linear/x/has_velocity_limits")) {
     s.max_velocity = kNoLimit;
     s.min_velocity = -kNoLimit;
   }
-  s.max_acceleration = read_double(p, "linear/x/max_acceleration", s.max_acceleration);
-  s.min_acceleration = read_double(p, "linear/x/min_acceleration", s.min_acceleration);
+  s.max_acceleration = read_double_parameter(p, "linear/x/max_acceleration", s.max_acceleration);
+  s.min_acceleration = read_double_parameter(p, "linear/x/min_acceleration", s.min_acceleration);
   if (!read_switch(p, "linear/x/has_acceleration_limits")) {
     s.max_acceleration = kNoLimit;
     s.min_acceleration = -kNoLimit;
   }
-  s.max_yaw_rate = read_double(p, "angular/z/max_velocity", s.max_yaw_rate);
+  s.max_yaw_rate = read_double_parameter(p, "angular/z/max_velocity", s.max_yaw_rate);
   if (!read_switch(p, "angular/z/has_velocity_limits")) s.max_yaw_rate = kNoLimit;
-  s.max_yaw_acceleration = read_double(p, "angular/z/max_acceleration", s.max_yaw_acceleration);
+  s.max_yaw_acceleration = read_double_parameter(p, "angular/z/max_acceleration", s.max_yaw_acceleration);
   if (!read_switch(p, "angular/z/has_acceleration_limits")) s.max_yaw_acceleration = kNoLimit;
-  s.max_steering_angle = read_double(p, "steering/max_angle", s.max_steering_angle);
-  s.max_steering_rate = read_double(p, "steering/max_rate", s.max_steering_rate);
-  s.max_steering_torque = read_double(p, "steering/max_torque", s.max_steering_torque);
-  s.steering_p = read_double(p, "steering/p", s.steering_p);
-  s.steering_d = read_double(p, "steering/d", s.steering_d);
-  s.max_drive_torque = read_double(p, "drive/max_torque", s.max_drive_torque);
-  s.drive_ff = read_double(p, "drive/ff", s.drive_ff);
-  s.drive_p = read_double(p, "drive/p", s.drive_p);
-  s.drive_i = read_double(p, "drive/i", s.drive_i);
-  s.drive_i_clamp = read_double(p, "drive/i_clamp", s.drive_i_clamp);
+  s.max_steering_angle = read_double_parameter(p, "steering/max_angle", s.max_steering_angle);
+  s.max_steering_rate = read_double_parameter(p, "steering/max_rate", s.max_steering_rate);
+  s.max_steering_torque = read_double_parameter(p, "steering/max_torque", s.max_steering_torque);
+  s.steering_p = read_double_parameter(p, "steering/p", s.steering_p);
+  s.steering_d = read_double_parameter(p, "steering/d", s.steering_d);
+  s.max_drive_torque = read_double_parameter(p, "drive/max_torque", s.max_drive_torque);
+  s.drive_ff = read_double_parameter(p, "drive/ff", s.drive_ff);
+  s.drive_p = read_double_parameter(p, "drive/p", s.drive_p);
+  s.drive_i = read_double_parameter(p, "drive/i", s.drive_i);
+  s.drive_i_clamp = read_double_parameter(p, "drive/i_clamp", s.drive_i_clamp);
   try {
     validate(s);
   } catch (const std::invalid_argument& error) {

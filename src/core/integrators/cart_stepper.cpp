@@ -47,6 +47,27 @@ void require_valid_step_size(double step_size) {
   throw StepError(message.str());
 }
 
+/// Throws StepError naming the first non-finite coordinate of (z, y) or quasi-velocity of `next`:
+/// what every adapter checks before it hands a step's result out.
+void require_finite_result(const std::string& integrator, double time, double step_size,
+                           const Eigen::Matrix<double, kBirkhoffianSize, 1>& z,
+                           const Eigen::Matrix<double, kPassiveSize, 1>& y) {
+  for (int i = 0; i < kBirkhoffianSize; ++i) {
+    if (!std::isfinite(z(i))) throw_non_finite(integrator, time, step_size, kBirkhoffianNames[i], z(i));
+  }
+  for (int i = 0; i < kPassiveSize; ++i) {
+    if (!std::isfinite(y(i))) throw_non_finite(integrator, time, step_size, kPassiveNames[i], y(i));
+  }
+}
+void require_finite_speeds(const std::string& integrator, double time, double step_size, const CartState& next) {
+  if (!std::isfinite(next.forward_speed)) {
+    throw_non_finite(integrator, time, step_size, "forward_speed omega1 (singular mass matrix?)", next.forward_speed);
+  }
+  if (!std::isfinite(next.steering_rate)) {
+    throw_non_finite(integrator, time, step_size, "steering_rate omega2 (singular mass matrix?)", next.steering_rate);
+  }
+}
+
 /// Generic stepper + cart system → CartStepper. Transactional: the state, the statistics and the
 /// stepper's own memory (dopri5's step-size guess) change only when the whole step succeeded.
 template <class Stepper, class System>
@@ -71,19 +92,9 @@ class CartStepperAdapter final : public CartStepper {
     } catch (const StepError& error) {
       throw StepError(name_ + ": " + error.what());
     }
-    for (int i = 0; i < kBirkhoffianSize; ++i) {
-      if (!std::isfinite(point.z(i))) throw_non_finite(name_, time, step_size, kBirkhoffianNames[i], point.z(i));
-    }
-    for (int i = 0; i < kPassiveSize; ++i) {
-      if (!std::isfinite(point.y(i))) throw_non_finite(name_, time, step_size, kPassiveNames[i], point.y(i));
-    }
+    require_finite_result(name_, time, step_size, point.z, point.y);
     const CartState next = system_.to_cart_state(point.z, point.y, time + step_size);
-    if (!std::isfinite(next.forward_speed)) {
-      throw_non_finite(name_, time, step_size, "forward_speed omega1 (singular mass matrix?)", next.forward_speed);
-    }
-    if (!std::isfinite(next.steering_rate)) {
-      throw_non_finite(name_, time, step_size, "steering_rate omega2 (singular mass matrix?)", next.steering_rate);
-    }
+    require_finite_speeds(name_, time, step_size, next);
     ++counted.steps;
     state = next;
     statistics = counted;
@@ -128,20 +139,10 @@ class CarriedCartStepperAdapter final : public CartStepper {
       throw StepError(name_ + ": " + error.what());
     }
     const auto& point = carried_.point;
-    for (int i = 0; i < kBirkhoffianSize; ++i) {
-      if (!std::isfinite(point.z(i))) throw_non_finite(name_, time, step_size, kBirkhoffianNames[i], point.z(i));
-    }
-    for (int i = 0; i < kPassiveSize; ++i) {
-      if (!std::isfinite(point.y(i))) throw_non_finite(name_, time, step_size, kPassiveNames[i], point.y(i));
-    }
+    require_finite_result(name_, time, step_size, point.z, point.y);
     carried_.reduce_angles();
     const CartState next = carried_.output(system_, time + step_size);
-    if (!std::isfinite(next.forward_speed)) {
-      throw_non_finite(name_, time, step_size, "forward_speed omega1 (singular mass matrix?)", next.forward_speed);
-    }
-    if (!std::isfinite(next.steering_rate)) {
-      throw_non_finite(name_, time, step_size, "steering_rate omega2 (singular mass matrix?)", next.steering_rate);
-    }
+    require_finite_speeds(name_, time, step_size, next);
     carried_.valid = true;
     ++counted.steps;
     state = next;
