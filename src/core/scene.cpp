@@ -100,7 +100,7 @@ CartState read_initial_state(const SceneReader& reader, const YAML::Node& node) 
 IntegratorSettings read_integrator(const SceneReader& reader, const YAML::Node& node, const std::string& key) {
   reader.require_map(node, key,
                      {"name", "step_size", "tolerance", "birkhoffian_form", "max_newton_iterations",
-                      "newton_tolerance", "compensated_summation"});
+                      "newton_tolerance", "compensated_summation", "local_error_estimate"});
   IntegratorSettings settings;
   settings.name = reader.choice(node, key, "name", known_integrators());
   settings.step_size = reader.required_number(node, key, "step_size", Range::kPositive);
@@ -114,6 +114,8 @@ IntegratorSettings read_integrator(const SceneReader& reader, const YAML::Node& 
       reader.optional_number(node, key, "newton_tolerance", Range::kPositive, settings.newton_tolerance);
   settings.compensated_summation =
       reader.optional_boolean(node, key, "compensated_summation", settings.compensated_summation);
+  settings.local_error_estimate =
+      reader.optional_boolean(node, key, "local_error_estimate", settings.local_error_estimate);
   return settings;
 }
 

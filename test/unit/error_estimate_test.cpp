@@ -2,24 +2,32 @@
 //
 // On the paper's closed-form case (docs eq. (3.9)) one step from the exact state at t = 2 s is
 // compared with the exact state at t + h. Every method that has an estimate must
-//  - record a finite ê ≥ 0 on every step (non-Birkhoffian methods: all of them, now);
+//  - record a finite ê ≥ 0 on every step (every registered method);
 //  - over-estimate its true local error (ê measures an embedded lower-order solution's error),
 //    on the components the closed form gives (x, y, θ, χ, π1), with the same weights;
 //  - for the fixed-step methods, shrink by 2^(p̂+1) when h halves (p̂ the embedded order: rk2's
 //    Euler 1, rk4's Simpson-type 2, midpoint's Euler predictor 1): ê is an asymptotic estimate,
 //    not noise. The ratio is asserted to ±25 %.
-// The estimate-to-true ratio is printed.
+// The Birkhoffian members (endpoint quadrature, docs/birkhoffian.md eqs. (B.36)–(B.37)): birkhoff2's ê
+// is its true local error within a factor 3 with order 3; the Gauss members' and the compositions' ê
+// bounds the true error with slope s + 2 (Gauss) or 4 (compositions: the sub-steps' O(h³) error vectors,
+// summed, cancel to O(h⁴) since Σγᵢ³ = 0); the
+// estimate only observes (bit-for-bit trajectory with it on or off); a new command torque is not
+// mistaken for the last step's end rate. The estimate-to-true ratios are printed.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <cstring>
 #include <string>
+#include <vector>
 
 #include "birkhoff_cart/core/diagnostics.h"
 #include "birkhoff_cart/core/integrators/cart_stepper.h"
 #include "birkhoff_cart/core/reference_solution.h"
+#include "birkhoff_cart/core/run_summary.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
 
@@ -100,17 +108,152 @@ INSTANTIATE_TEST_SUITE_P(NonBirkhoffianMethods, LocalErrorEstimate,
                            return std::string(info.param.integrator);
                          });
 
-TEST(LocalErrorEstimate, EveryRegisteredMethodRecordsAFiniteEstimateOrNoneAtAll) {
-  // The lead's Birkhoffian members fill the same field through record_local_error_estimate();
-  // until they do, "none" is allowed for them, never a half-filled record.
+// The Birkhoffian members' endpoint-quadrature estimate (gauss_collocation.h, docs/birkhoffian.md
+// eqs. (B.36)–(B.37)) on the same closed-form steps.
+constexpr double kSlopeSlack = 0.4;       // on log2(ê(h)/ê(h/2)) against the estimate's order [-]
+constexpr double kRoundOffFloor = 1e-13;  // true errors below this are round-off, not a local error [-]
+
+/// log2(ê(h)/ê(h/2)) [-].
+double estimate_slope(const std::string& integrator, double h) {
+  return std::log2(one_step(integrator, h).estimate / one_step(integrator, h / 2).estimate);
+}
+
+TEST(BirkhoffianEstimate, Birkhoff2EstimateIsItsTrueLocalErrorWithinAFactorThreeAndOrderThree) {
+  // Simpson on {0, ½, 1} against the midpoint rule: the classical O(h³) estimate of its own error.
+  for (double h : {0.08, 0.04, 0.02, 0.01, 0.005}) {
+    const OneStep step = one_step("birkhoff2", h);
+    ASSERT_TRUE(step.has_estimate);
+    const double ratio = step.estimate / step.true_error;
+    std::printf("birkhoff2 h = %-6g s: ê = %.3e, true = %.3e, ê/true = %.3g\n", h, step.estimate, step.true_error, ratio);
+    EXPECT_GE(ratio, 0.3) << h;
+    EXPECT_LE(ratio, 3.0) << h;
+  }
+  for (double h : {0.04, 0.01}) EXPECT_NEAR(estimate_slope("birkhoff2", h), 3.0, kSlopeSlack) << h;
+}
+
+struct BoundExpectation {
+  const char* integrator;
+  int estimate_order;               ///< slope of ê: s + 2 for Gauss, 4 for the compositions (Σγᵢ³ = 0)
+  std::vector<double> bound_steps;  ///< h [s] where the true error is above round-off
+  double slope_step;                ///< h [s] of the slope measurement (ê above round-off at h/2)
+};
+
+class BirkhoffianBound : public ::testing::TestWithParam<BoundExpectation> {};
+
+TEST_P(BirkhoffianBound, EstimateBoundsTheTrueLocalErrorWithItsOwnOrder) {
+  const BoundExpectation expectation = GetParam();
+  for (double h : expectation.bound_steps) {
+    const OneStep step = one_step(expectation.integrator, h);
+    ASSERT_TRUE(step.has_estimate) << expectation.integrator;
+    ASSERT_GT(step.true_error, kRoundOffFloor) << expectation.integrator << " h = " << h << ": choose a larger step";
+    std::printf("%-19s h = %-6g s: ê = %.3e, true = %.3e, ê/true = %.3g\n", expectation.integrator, h, step.estimate,
+                step.true_error, step.estimate / step.true_error);
+    EXPECT_GE(step.estimate, step.true_error) << expectation.integrator << " h = " << h;
+  }
+  const double slope = estimate_slope(expectation.integrator, expectation.slope_step);
+  std::printf("%-19s log2(ê(h)/ê(h/2)) at h = %g s: %.3f (expected %d)\n", expectation.integrator,
+              expectation.slope_step, slope, expectation.estimate_order);
+  EXPECT_NEAR(slope, expectation.estimate_order, kSlopeSlack) << expectation.integrator;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    GaussAndCompositions, BirkhoffianBound,
+    ::testing::Values(BoundExpectation{"birkhoff_gauss4", 4, {0.16, 0.08, 0.04, 0.02, 0.01}, 0.04},
+                      BoundExpectation{"birkhoff_gauss6", 5, {0.32, 0.16, 0.08}, 0.08},
+                      BoundExpectation{"birkhoff_gauss8", 6, {0.32, 0.16}, 0.08},
+                      BoundExpectation{"birkhoff4", 4, {0.16, 0.08, 0.04, 0.02, 0.01}, 0.02},
+                      BoundExpectation{"birkhoff4_suzuki", 4, {0.16, 0.08, 0.04, 0.02, 0.01}, 0.02},
+                      BoundExpectation{"birkhoff6_kahan_li", 4, {0.16, 0.08, 0.04}, 0.02},
+                      BoundExpectation{"birkhoff8_kahan_li", 4, {0.32, 0.16}, 0.02}),
+    [](const ::testing::TestParamInfo<BoundExpectation>& info) { return std::string(info.param.integrator); });
+
+bool is_birkhoffian(const std::string& integrator) { return integrator.rfind("birkhoff", 0) == 0; }
+
+/// `steps` steps of `scene` with the estimate on or off; the states after each step.
+std::vector<CartState> trajectory(Scene scene, bool estimate, int steps, StepStatistics* statistics) {
+  scene.integrator.local_error_estimate = estimate;
+  Simulation simulation(scene);
+  std::vector<CartState> states;
+  for (int k = 0; k < steps; ++k) {
+    simulation.step();
+    states.push_back(simulation.state());
+  }
+  *statistics = simulation.statistics();
+  return states;
+}
+
+TEST(BirkhoffianEstimate, OnlyObservesTheTrajectoryIsTheSameBitForBitWithItOnOrOff) {
+  // The whirl (autonomous chart, angles reduced, first same as last) and the paper case (rep (a): a
+  // new chart epoch every step).
+  for (const char* scene_name : {"jackknife_whirl", "paper_special"}) {
+    Scene scene = load_scene(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/" + scene_name + ".yaml");
+    scene.reference = ReferenceSettings{};
+    scene.integrator.step_size = 0.01;  // [s]
+    for (const std::string& integrator : integrator_names()) {
+      if (!is_birkhoffian(integrator)) continue;
+      scene.integrator.name = integrator;
+      StepStatistics with;
+      StepStatistics without;
+      const std::vector<CartState> on = trajectory(scene, true, 60, &with);
+      const std::vector<CartState> off = trajectory(scene, false, 60, &without);
+      for (std::size_t k = 0; k < on.size(); ++k) {
+        ASSERT_EQ(std::memcmp(&on[k], &off[k], sizeof(CartState)), 0) << scene_name << " " << integrator << " step " << k;
+      }
+      EXPECT_EQ(with.steps_with_error_estimate, 60u) << integrator;
+      EXPECT_FALSE(has_local_error_estimate(without)) << integrator;
+      EXPECT_EQ(with.newton_iterations_total, without.newton_iterations_total) << integrator;
+      EXPECT_GT(with.rhs_evaluations, without.rhs_evaluations) << integrator;
+      std::printf("%-15s %-19s rhs evaluations per step: estimate on %.3f, off %.3f\n", scene_name,
+                  integrator.c_str(), static_cast<double>(with.rhs_evaluations) / 60.0,
+                  static_cast<double>(without.rhs_evaluations) / 60.0);
+    }
+  }
+}
+
+TEST(BirkhoffianEstimate, ANewCommandIsSeenAtTheStepStartNotTheLastStepsEndRate) {
+  // First same as last must not carry F(w⁺) of the old torque into the step after a command.
+  Scene scene = load_scene(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/driven.yaml");
+  scene.integrator.name = "birkhoff_gauss4";
+  scene.integrator.step_size = 0.01;  // [s]
+  constexpr double kNewTorque = 5.0;  // [N·m]
+  Simulation carried(scene);
+  for (int k = 0; k < 20; ++k) carried.step();
+  Scene restarted_scene = scene;
+  restarted_scene.initial_state = carried.state();
+  carried.set_steering_command(kNewTorque);
+  carried.step();
+  Simulation restarted(restarted_scene);  // no memory: F(w, tₖ) evaluated with the new torque
+  restarted.set_steering_command(kNewTorque);
+  restarted.step();
+  const double carried_estimate = carried.statistics().local_error_estimate_last_step;
+  const double restarted_estimate = restarted.statistics().local_error_estimate_last_step;
+  std::printf("after a new command: ê carried = %.6e, restarted = %.6e\n", carried_estimate, restarted_estimate);
+  EXPECT_NEAR(carried_estimate, restarted_estimate, 1e-6 * restarted_estimate);
+}
+
+TEST(LocalErrorEstimate, EveryRegisteredMethodRecordsAFiniteEstimateAndTheSummaryShowsIt) {
   for (const std::string& integrator : integrator_names()) {
     const OneStep result = one_step(integrator, 0.01);
-    if (!result.has_estimate) {
-      EXPECT_TRUE(std::isnan(result.estimate)) << integrator;
-      continue;
-    }
+    ASSERT_TRUE(result.has_estimate) << integrator;
     EXPECT_TRUE(std::isfinite(result.estimate) && result.estimate >= 0.0) << integrator << ": " << result.estimate;
+    Scene scene = load_scene(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/free_coast.yaml");
+    scene.integrator.name = integrator;
+    Simulation simulation(scene);
+    for (int k = 0; k < 5; ++k) simulation.step();
+    const std::string summary = local_error_estimate_summary(simulation.statistics(), integrator);
+    EXPECT_EQ(summary.find("none"), std::string::npos) << integrator << ": " << summary;
+    EXPECT_EQ(simulation.statistics().steps_with_error_estimate, 5u) << integrator;
   }
+}
+
+TEST(LocalErrorEstimate, TurnedOffTheBirkhoffianMembersRecordNoneAndTheSummarySaysSo) {
+  Scene scene = load_scene(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/free_coast.yaml");
+  scene.integrator.name = "birkhoff8_kahan_li";
+  scene.integrator.local_error_estimate = false;
+  Simulation simulation(scene);
+  simulation.step();
+  EXPECT_FALSE(has_local_error_estimate(simulation.statistics()));
+  EXPECT_NE(local_error_estimate_summary(simulation.statistics(), "birkhoff8_kahan_li").find("none"), std::string::npos);
 }
 
 TEST(LocalErrorEstimate, RecordKeepsLastLargestAndSumAndResetForgetsThem) {

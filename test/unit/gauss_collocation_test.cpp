@@ -9,6 +9,7 @@
 #include <utility>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "birkhoff_cart/core/angle_reduction.h"
 #include "birkhoff_cart/core/cart_model.h"
@@ -60,6 +61,43 @@ TEST(GaussLegendreTableau, SatisfiesTheSimplifyingConditionsOfOrderTwoS) {
   EXPECT_DOUBLE_EQ(gauss_legendre_tableau(1).nodes[0], 0.5);
   EXPECT_DOUBLE_EQ(gauss_legendre_tableau(1).increment_weights[0], 2.0);
   EXPECT_THROW(gauss_legendre_tableau(5), std::invalid_argument);
+}
+
+TEST(GaussLegendreTableau, EmbeddedWeightsHaveOrderSPlusOneAndTheEstimateWeightsAreTheirDifference) {
+  // On the nodes τ = (0, c₁ … c_s, 1): Σ b̂ⱼ τⱼ^{k−1} = 1/k for k ≤ s + 1 (exact to degree s, order
+  // s + 1), and not for k = s + 2 when s ≥ 2 (else b̂ would be Gauss itself and e ≡ 0); s = 1 is
+  // Simpson's rule (exact to degree 3). η = (−b̂₀, b − b̂, −b̂_{s+1}) annihilates degree ≤ s, and
+  // b̂₀ = 1/((s+1)(s+2)), b̂_{s+1} = (−1)^{s+1} b̂₀ (eq. (B.36)).
+  for (int s = 1; s <= kMaxGaussStages; ++s) {
+    const GaussLegendreTableau& tableau = gauss_legendre_tableau(s);
+    std::vector<double> nodes = {0.0};
+    for (int i = 0; i < s; ++i) nodes.push_back(tableau.nodes[i]);
+    nodes.push_back(1.0);
+    auto quadrature = [&](const auto& weights, int power) {
+      double sum = 0.0;
+      for (int j = 0; j < s + 2; ++j) sum += weights[j] * std::pow(nodes[j], power);
+      return sum;
+    };
+    const int exact_degree = s == 1 ? 3 : s;
+    for (int k = 1; k <= exact_degree + 1; ++k) {
+      EXPECT_NEAR(quadrature(tableau.embedded_weights, k - 1), 1.0 / k, 1e-15) << "s = " << s << ", k = " << k;
+    }
+    EXPECT_GT(std::abs(quadrature(tableau.embedded_weights, exact_degree + 1) - 1.0 / (exact_degree + 2)), 1e-4)
+        << "s = " << s << ": the embedded rule must not be more accurate than stated";
+    for (int power = 0; power <= s; ++power) {
+      EXPECT_NEAR(quadrature(tableau.estimate_weights, power), 0.0, 1e-15) << "s = " << s << ", power = " << power;
+    }
+    const double beta = 1.0 / ((s + 1) * (s + 2));
+    EXPECT_NEAR(tableau.embedded_weights[0], beta, 1e-16);
+    EXPECT_NEAR(tableau.embedded_weights[s + 1], (s % 2 == 1 ? beta : -beta), 1e-16);
+    for (int i = 0; i < s; ++i) {
+      EXPECT_NEAR(tableau.estimate_weights[i + 1], tableau.weights[i] - tableau.embedded_weights[i + 1], 1e-15);
+    }
+    EXPECT_EQ(tableau.estimate_weights[0], -tableau.embedded_weights[0]);
+    EXPECT_EQ(tableau.estimate_weights[s + 1], -tableau.embedded_weights[s + 1]);
+  }
+  // s = 1: Simpson, (1, 4, 1)/6.
+  EXPECT_NEAR(gauss_legendre_tableau(1).embedded_weights[1], 4.0 / 6.0, 1e-16);
 }
 
 /// Straight coasting (χ = θ = 0, no loads): every rate is constant, so any method is exact and the

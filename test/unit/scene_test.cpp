@@ -220,6 +220,8 @@ TEST_F(SceneFiles, MinimalSceneGetsTheDocumentedDefaults) {
   EXPECT_EQ(scene.integrator.birkhoffian_form, "autonomous");
   EXPECT_EQ(scene.integrator.max_newton_iterations, 30);
   EXPECT_EQ(scene.integrator.newton_tolerance, 1e-14);
+  EXPECT_TRUE(scene.integrator.compensated_summation);
+  EXPECT_TRUE(scene.integrator.local_error_estimate);
   EXPECT_EQ(scene.output_rate, 100.0);
   EXPECT_TRUE(scene.effects.empty());
   EXPECT_EQ(scene.reference.kind, ReferenceSettings::Kind::kNone);
@@ -298,6 +300,10 @@ TEST_F(SceneFiles, MalformedScenesNameTheFileAndTheKey) {
        "effects.drive_torque.end_time"},
       {"unknown_integrator", edited("name: rk4", "name: euler"), "integrator.name"},
       {"zero_step", edited("step_size: 0.01", "step_size: 0.0"), "integrator.step_size"},
+      {"estimate_not_bool", edited("  step_size: 0.01\n", "  step_size: 0.01\n  local_error_estimate: often\n"),
+       "integrator.local_error_estimate"},
+      {"estimate_as_map", edited("  step_size: 0.01\n", "  step_size: 0.01\n  local_error_estimate: {on: true}\n"),
+       "integrator.local_error_estimate"},
       {"negative_step", edited("step_size: 0.01", "step_size: -0.01"), "integrator.step_size"},
       {"step_longer_than_run", edited("step_size: 0.01", "step_size: 10.0"), "integrator.step_size"},
       {"zero_duration", edited("duration: 5.0", "duration: 0"), "duration"},

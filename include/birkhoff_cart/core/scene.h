@@ -69,6 +69,7 @@ struct IntegratorSettings {
   int max_newton_iterations = 30;                 ///< per implicit step
   double newton_tolerance = 1e-14;                ///< on the scaled Newton update [-]
   bool compensated_summation = true;              ///< Birkhoffian members: Kahan/TwoSum state update
+  bool local_error_estimate = true;               ///< Birkhoffian members: compute ê (one more rhs evaluation a step)
 };
 
 /// What the simulation compares itself against, computed only when asked for.

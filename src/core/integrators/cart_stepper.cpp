@@ -3,6 +3,7 @@
 // type-erased CartStepper the simulation uses.
 #include "birkhoff_cart/core/integrators/cart_stepper.h"
 
+#include <array>
 #include <cmath>
 #include <functional>
 #include <sstream>
@@ -68,6 +69,12 @@ void require_finite_speeds(const std::string& integrator, double time, double st
   }
 }
 
+/// The command torques (steering, drive) [N·m] the effects read now; 0 for a source that is absent.
+std::array<double, 2> command_torques(const EffectSet& effects) {
+  return {effects.steering_command() ? effects.steering_command()->value : 0.0,
+          effects.drive_command() ? effects.drive_command()->value : 0.0};
+}
+
 /// Generic stepper + cart system → CartStepper. Transactional: the state, the statistics and the
 /// stepper's own memory (dopri5's step-size guess) change only when the whole step succeeded.
 template <class Stepper, class System>
@@ -117,7 +124,7 @@ template <class Stepper, class System>
 class CarriedCartStepperAdapter final : public CartStepper {
  public:
   CarriedCartStepperAdapter(const Stepper& stepper, const CartModel& model, const EffectSet& effects)
-      : stepper_(stepper), system_(model, effects), name_(Stepper::name()) {}
+      : stepper_(stepper), system_(model, effects), effects_(effects), name_(Stepper::name()) {}
 
   const std::string& name() const override { return name_; }
   int order() const override { return Stepper::kOrder; }
@@ -128,6 +135,10 @@ class CarriedCartStepperAdapter final : public CartStepper {
     const double time = state.time;  // tₖ [s]
     system_.begin_step(time);
     if (!carried_.continues(state)) carried_.start_from(system_, state);
+    // A new command changes ẇ at the same (w, t): the last step's F(w⁺) is not this step's F(w).
+    const std::array<double, 2> commands = command_torques(effects_);
+    if (commands != commands_) carried_.memory.forget_end_rate();
+    commands_ = commands;
     StepStatistics counted = statistics;
     counted.newton_iterations_last_step = 0;
     // On any failure the carried state is dropped (the next step starts afresh from the caller's
@@ -152,6 +163,8 @@ class CarriedCartStepperAdapter final : public CartStepper {
  private:
   Stepper stepper_;
   System system_;
+  const EffectSet& effects_;
+  std::array<double, 2> commands_{};  ///< command torques at the last step [N·m]
   std::string name_;
   CarriedCartState<System, typename Stepper::template Memory<System>> carried_;
 };
@@ -210,6 +223,7 @@ std::unique_ptr<CartStepper> make_cart_stepper(const IntegratorSettings& setting
   CollocationSettings collocation;
   collocation.max_iterations = settings.max_newton_iterations;
   collocation.compensated = settings.compensated_summation;
+  collocation.estimate_local_error = settings.local_error_estimate;
   if (name == "birkhoff2") return wrap(GaussCollocation<1>(collocation), settings, model, effects);
   if (name == "birkhoff4") return wrap(BirkhoffComposition<TripleJumpWeights>(collocation), settings, model, effects);
   if (name == "birkhoff_gauss4") return wrap(GaussCollocation<2>(collocation), settings, model, effects);

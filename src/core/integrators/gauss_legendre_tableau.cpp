@@ -105,6 +105,20 @@ GaussLegendreTableau compute_tableau(int s) {
     }
   }
   for (int i = 0; i < s; ++i) tableau.increment_weights[i] = static_cast<double>(system[i][s] / system[i][i]);
+
+  // Embedded weights on {0, c₁ … c_s, 1} (eq. (B.36)): endpoint weights ±β, β = 1/((s+1)(s+2)), with
+  // the sign (−1)^{s+1} that makes the rule exact to degree s; interior ones from exactness to s − 1.
+  const Real beta = 1.0L / static_cast<Real>((s + 1) * (s + 2));
+  const Real end_sign = (s % 2 == 1) ? 1.0L : -1.0L;
+  tableau.embedded_weights[0] = static_cast<double>(beta);
+  tableau.embedded_weights[s + 1] = static_cast<double>(end_sign * beta);
+  tableau.estimate_weights[0] = static_cast<double>(-beta);
+  tableau.estimate_weights[s + 1] = static_cast<double>(-end_sign * beta);
+  for (int j = 0; j < s; ++j) {
+    const Real defect_weight = beta * (lagrange_basis(nodes, s, j, 0.0L) + end_sign * lagrange_basis(nodes, s, j, 1.0L));
+    tableau.embedded_weights[j + 1] = static_cast<double>(b[j] - defect_weight);
+    tableau.estimate_weights[j + 1] = static_cast<double>(defect_weight);  // bⱼ − b̂ⱼ
+  }
   return tableau;
 }
 

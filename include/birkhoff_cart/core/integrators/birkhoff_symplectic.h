@@ -17,6 +17,12 @@
 //   birkhoff8_kahan_li  Kahan & Li 1997 s17odr8a, 17 sub-steps, order 8 (GNI eq. (V.3.12)).
 // The sub-steps share one memory of stage derivatives, so each starts from a linear extrapolation of
 // the two sub-steps before it, and one Jacobian with a Newton matrix per distinct sub-step size.
+//
+// Local error estimate: the sum of the sub-steps' error vectors (gauss_collocation.h, eq. (B.37)),
+// normed once per composed step. The sub-steps' leading O((γᵢh)³) terms cancel in the sum because
+// Σγᵢ³ = 0 (the compositions' third-order condition), the rest does not: ê = O(h⁴) (measured slope 4.0
+// on the paper case, test/unit/error_estimate_test.cpp), a conservative bound of an O(h^{p+1}) error.
+// A sub-step's F(w⁺) is the next sub-step's F(w) (first same as last): one extra evaluation each.
 #pragma once
 
 #include <array>
@@ -91,20 +97,32 @@ class BirkhoffComposition {
   void step(const System& system, StateVector<System, S>& z, PassiveVector<System, S>& y, double t, double h,
             StepStatistics& statistics) const {
     statistics.newton_iterations_last_step = 0;
+    const StateVector<System, S> z_start = z;
+    const PassiveVector<System, S> y_start = y;
+    LocalErrorVectors<System, S> error;  // Σ of the sub-steps' error vectors
     double time = t;  // start of the current sub-step [s]
     for (double gamma : Weights::weights()) {
-      base_.advance(system, z, y, time, gamma * h, statistics);  // z ← Φ_{γh}(z) from `time`
+      base_.advance(system, z, y, time, gamma * h, statistics, &error);  // z ← Φ_{γh}(z) from `time`
       time += gamma * h;
+    }
+    if (base_.settings().estimate_local_error) {
+      record_local_error_estimate(statistics, local_error_norm<System, S>(z_start, y_start, error.z, error.y));
     }
   }
 
   template <class System>
   void advance_compensated(const System& system, CompensatedPoint<System>& point, CollocationMemory<System, 1>& memory,
                            double t, double h, StepStatistics& statistics) const {
+    const StateVector<System, double> z_start = point.z;
+    const PassiveVector<System, double> y_start = point.y;
+    LocalErrorVectors<System, double> error;  // Σ of the sub-steps' error vectors
     double time = t;
     for (double gamma : Weights::weights()) {
-      base_.advance_compensated(system, point, memory, time, gamma * h, statistics);
+      base_.advance_compensated(system, point, memory, time, gamma * h, statistics, &error);
       time += gamma * h;
+    }
+    if (base_.settings().estimate_local_error) {
+      record_local_error_estimate(statistics, local_error_norm<System, double>(z_start, y_start, error.z, error.y));
     }
   }
 

@@ -27,6 +27,16 @@
 //    θ̇ reads z), so d + 1 sweeps are exact; without it, sweeps until settled;
 //  - compensated summation (Kahan, TwoSum) of w⁺ = w + Σ hbⱼFⱼ and y⁺, when the caller carries the
 //    remainders (advance_compensated; needs a chart linear in z, System::kDarbouxChartIsLinear).
+//
+// Local error estimate (CollocationSettings::estimate_local_error; docs/birkhoffian.md §10.5, eqs.
+// (B.36)–(B.37)): e = w⁺ − ŵ, ŵ = w + h (b̂₀ F(w, tₖ) + Σᵢ b̂ᵢ Fᵢ + b̂_{s+1} F(w⁺, tₖ₊₁)) an embedded
+// solution of order s + 1 on the nodes {0, c₁ … c_s, 1}; e = −hβ(δ(0) + (−1)^{s+1} δ(1)), the
+// collocation polynomial's defect at the step's ends. s = 1: Simpson against the midpoint rule, the
+// classical O(h³) estimate of its own error (within a factor 3 of the true local error on the paper
+// case); s ≥ 2: O(h^{s+2}), a conservative bound of the O(h^{2s+1}) error. The same on g for the
+// passive coordinates. Cost: one rhs evaluation F(w⁺) (first same as last: it is the next step's
+// F(w)) and two passive evaluations a step. It vanishes identically on linear autonomous ẇ = Lw
+// (the defect is then a multiple of the node polynomial, whose end values cancel).
 #pragma once
 
 #include <Eigen/Core>
@@ -43,6 +53,7 @@
 #include "birkhoff_cart/core/birkhoffian_system.h"
 #include "birkhoff_cart/core/diagnostics.h"
 #include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/integrators/error_estimate.h"
 #include "birkhoff_cart/core/integrators/gauss_legendre_tableau.h"
 #include "birkhoff_cart/core/integrators/newton.h"
 
@@ -109,9 +120,30 @@ struct CollocationMemory {
   std::array<double, kCachedStepSizes> cached_step{};        ///< h [s] of each cached inverse
   std::array<StageMatrix, kCachedStepSizes> cached_inverse;  ///< (I − h A ⊗ J)⁻¹
 
+  // First same as last (the local error estimate, eq. (B.37)): F(w⁺, tₖ₊₁) of the last step stands
+  // in for the next step's F(w, tₖ) while that step starts from the same point and time.
+  bool end_rate_valid = false;
+  double end_time = 0.0;                                                     ///< tₖ₊₁ [s]
+  StateVector<System, double> end_point = StateVector<System, double>::Zero();  ///< w⁺
+  StateVector<System, double> end_rate = StateVector<System, double>::Zero();   ///< F(w⁺, tₖ₊₁)
+
   void clear() {
     count = 0;
     forget_jacobian();
+    forget_end_rate();
+  }
+  /// After anything that changes ẇ at a given (w, t) between steps (a new command torque).
+  void forget_end_rate() { end_rate_valid = false; }
+  /// Does the remembered F(w⁺, tₖ₊₁) belong to the step starting at (w, t)? Equal to round-off: the
+  /// chart's round trip and t₀ + n·h against tₖ + h differ by an ulp or two; a new chart epoch
+  /// (rep (a)) or a reduced angle (whole turns) differ by far more.
+  bool end_rate_belongs_to(const StateVector<System, double>& w, double t) const {
+    constexpr double kRoundOff = 8.0 * std::numeric_limits<double>::epsilon();
+    if (!end_rate_valid || !(std::abs(t - end_time) <= kRoundOff * std::max(1.0, std::abs(t)))) return false;
+    for (int k = 0; k < kDimension; ++k) {
+      if (!(std::abs(w(k) - end_point(k)) <= kRoundOff * std::abs(end_point(k)))) return false;
+    }
+    return true;
   }
   void forget_jacobian() {
     jacobian_valid = false;
@@ -133,6 +165,16 @@ struct CompensatedPoint {
 struct CollocationSettings {
   int max_iterations = 30;  ///< simplified-Newton iterations per step before StepError [-]
   bool compensated = true;  ///< Kahan/TwoSum summation of the update (advance_compensated)
+  /// Record the local error estimate ê (eq. (B.37)): one more rhs evaluation and two passive ones a
+  /// step; observes only (the trajectory is the same bit for bit either way).
+  bool estimate_local_error = true;
+};
+
+/// The error vectors e = x⁺ − x̂ of one or more steps (compositions add their sub-steps').
+template <class System, class S>
+struct LocalErrorVectors {
+  StateVector<System, S> z = StateVector<System, S>::Constant(S(0.0));
+  PassiveVector<System, S> y = PassiveVector<System, S>::Constant(S(0.0));
 };
 
 /// s-stage Gauss–Legendre collocation in the Darboux chart (order 2s, symmetric, K(z,t)-symplectic).
@@ -168,21 +210,23 @@ class GaussCollocation {
   }
 
   /// step() without resetting the per-step iteration counter (compositions call it per sub-step).
+  /// The local error estimate is recorded, or, with `error_sum`, added to it (compositions).
   template <class System, class S>
   void advance(const System& system, StateVector<System, S>& z, PassiveVector<System, S>& y, double t, double h,
-               StepStatistics& statistics) const {
+               StepStatistics& statistics, LocalErrorVectors<System, S>* error_sum = nullptr) const {
     StateVector<System, S> z_remainder = StateVector<System, S>::Constant(S(0.0));
     PassiveVector<System, S> y_remainder = PassiveVector<System, S>::Constant(S(0.0));
     CollocationMemory<System, Stages> fresh;  // no history: explicit start, Jacobian at the step's start
-    collocate(system, z, z_remainder, y, y_remainder, t, h, fresh, statistics);
+    collocate(system, z, z_remainder, y, y_remainder, t, h, fresh, statistics, error_sum);
   }
 
   /// One step of the carried point (remainders kept when settings().compensated and the chart is
   /// linear), with starting values from and into `memory`. Does not reset the per-step iteration
-  /// counter.
+  /// counter. The local error estimate is recorded, or, with `error_sum`, added to it.
   template <class System>
   void advance_compensated(const System& system, CompensatedPoint<System>& point, CollocationMemory<System, Stages>& memory,
-                           double t, double h, StepStatistics& statistics) const {
+                           double t, double h, StepStatistics& statistics,
+                           LocalErrorVectors<System, double>* error_sum = nullptr) const {
     const bool compensate = settings_.compensated && collocation_detail::LinearChart<System>::value;
     if (!compensate) {
       point.z += point.z_remainder;
@@ -190,7 +234,7 @@ class GaussCollocation {
       point.z_remainder.setZero();
       point.y_remainder.setZero();
     }
-    collocate(system, point.z, point.z_remainder, point.y, point.y_remainder, t, h, memory, statistics);
+    collocate(system, point.z, point.z_remainder, point.y, point.y_remainder, t, h, memory, statistics, error_sum);
     if (!compensate) {
       point.z_remainder.setZero();
       point.y_remainder.setZero();
@@ -204,8 +248,11 @@ class GaussCollocation {
   template <class System, class S>
   void collocate(const System& system, StateVector<System, S>& z, StateVector<System, S>& z_remainder,
                  PassiveVector<System, S>& y, PassiveVector<System, S>& y_remainder, double t, double h,
-                 CollocationMemory<System, Stages>& memory, StepStatistics& statistics) const {
+                 CollocationMemory<System, Stages>& memory, StepStatistics& statistics,
+                 LocalErrorVectors<System, S>* error_sum) const {
     using W = StateVector<System, S>;
+    using Y = PassiveVector<System, S>;
+    const bool estimate = settings_.estimate_local_error;
     const GaussLegendreTableau& tableau = gauss_legendre_tableau(Stages);
     std::array<double, Stages> stage_times{};  // tⱼ = tₖ + cⱼh [s]
     for (int i = 0; i < Stages; ++i) stage_times[i] = t + tableau.nodes[i] * h;
@@ -218,6 +265,8 @@ class GaussCollocation {
     // Starting stage increments Zᵢ⁽⁰⁾ (eq. (B.32)).
     Stages_<System, S> increments;   // Zᵢ = Wᵢ − w
     Stages_<System, S> stage_rates;  // Fⱼ at the latest evaluated stages
+    W start_rate = W::Constant(S(0.0));  // F(w, tₖ), for the estimate, when evaluated anyway
+    bool have_start_rate = false;
     if (memory.count > 0 && extrapolation_is_sound(memory, t, h)) {
       // Fⱼ⁽⁰⁾ = P(tₖ + cⱼh), P through the remembered (tₘ, Fₘ); Zᵢ⁽⁰⁾ = h Σⱼ aᵢⱼ Fⱼ⁽⁰⁾ (the collocation
       // polynomial's increments, not ∫P: for s = 1 the stage sees F at the midpoint only).
@@ -238,10 +287,17 @@ class GaussCollocation {
       const W rate = system.darboux_rates(w, S(t));
       ++statistics.rhs_evaluations;
       for (int i = 0; i < Stages; ++i) increments[i] = S(tableau.nodes[i] * h) * rate;
+      start_rate = rate;
+      have_start_rate = true;
+    }
+    if (estimate && !have_start_rate && memory.end_rate_belongs_to(values_of(w), t)) {
+      start_rate = memory.end_rate.template cast<S>();  // first same as last
+      have_start_rate = true;
     }
 
-    const int iterations =
-        solve_stages(system, tableau, w, w_remainder, stage_times, t, h, increments, stage_rates, memory, statistics);
+    double last_stage_change = 0.0;  // largest |ΔZ| of the final iteration
+    const int iterations = solve_stages(system, tableau, w, w_remainder, stage_times, t, h, increments, stage_rates,
+                                        memory, statistics, last_stage_change);
     statistics.newton_iterations_last_step += static_cast<std::uint64_t>(iterations);
     statistics.newton_iterations_total += static_cast<std::uint64_t>(iterations);
 
@@ -255,15 +311,103 @@ class GaussCollocation {
     // Passive coordinates by quadrature on the converged stages (eq. (B.35)).
     std::array<StateVector<System, S>, Stages> stage_points;  // Zⱼ = D⁻¹(w + Zⱼ, tⱼ)
     for (int j = 0; j < Stages; ++j) stage_points[j] = system.from_darboux(W(w + increments[j]), S(stage_times[j]));
-    passive_quadrature(system, tableau, stage_points, stage_times, h, y, y_remainder, statistics);
+    const W z_start = z;
+    const Y y_start = y;
+    std::array<Y, Stages> passive_rates;  // Gⱼ at the converged stages
+    passive_quadrature(system, tableau, stage_points, stage_times, h, y, y_remainder, passive_rates, statistics);
 
     z = system.from_darboux(w_next, S(t + h));
+    if (estimate) {
+      if (!have_start_rate) {
+        start_rate = system.darboux_rates(w, S(t));
+        ++statistics.rhs_evaluations;
+      }
+      estimate_local_error(system, tableau, w, start_rate, w_next, increments, stage_rates, last_stage_change,
+                           stage_times, z_start, y_start, z, y, passive_rates, t, h, memory, statistics, error_sum);
+    } else {
+      memory.forget_end_rate();
+    }
     if constexpr (collocation_detail::LinearChart<System>::value) {
       z_remainder = system.from_darboux(w_next_remainder, S(t + h));
     } else {
       z_remainder = W::Constant(S(0.0));
     }
     remember(memory, stage_times, stage_rates);
+  }
+
+  /// The local error estimate (eqs. (B.36)–(B.37)): e = w⁺ − ŵ = h Σⱼ ηⱼ F(node j) on the nodes
+  /// {0, c₁ … c_s, 1}, with F(w, tₖ) (first same as last, or evaluated), the stage rates Fᵢ and one
+  /// new evaluation F(w⁺, tₖ₊₁) (kept for the next step's start); the same quadrature on g for the
+  /// passive coordinates, with g at (z, y, tₖ) and (z⁺, y⁺, tₖ₊₁). ê = local_error_norm(e_z, e_y) is
+  /// recorded, or the vectors added to `error_sum`.
+  ///
+  /// The stage rates are those of the solve's last evaluation, one update before the final Zᵢ: they
+  /// are off by about J ΔZ, which moves e by ≲ 4 Σ|ηᵢ| |ΔZ| (h‖J‖ ≲ 4 where the iteration
+  /// contracts). Used when that is below a tenth of |e| (or e is at round-off), else re-evaluated at
+  /// the converged stages.
+  template <class System, class S>
+  void estimate_local_error(const System& system, const GaussLegendreTableau& tableau, const StateVector<System, S>& w,
+                            const StateVector<System, S>& start_rate, const StateVector<System, S>& w_next,
+                            const Stages_<System, S>& increments, Stages_<System, S>& stage_rates,
+                            double last_stage_change, const std::array<double, Stages>& stage_times,
+                            const StateVector<System, S>& z_start, const PassiveVector<System, S>& y_start,
+                            const StateVector<System, S>& z_next, const PassiveVector<System, S>& y_next,
+                            const std::array<PassiveVector<System, S>, Stages>& passive_rates, double t, double h,
+                            CollocationMemory<System, Stages>& memory, StepStatistics& statistics,
+                            LocalErrorVectors<System, S>* error_sum) const {
+    using W = StateVector<System, S>;
+    using Y = PassiveVector<System, S>;
+    const std::array<double, kMaxGaussStages + 2>& eta = tableau.estimate_weights;
+    const double t_next = t + h;
+    const W end_rate = system.darboux_rates(w_next, S(t_next));  // F(w⁺, tₖ₊₁)
+    ++statistics.rhs_evaluations;
+    memory.end_rate_valid = true;
+    memory.end_time = t_next;
+    memory.end_point = values_of(w_next);
+    memory.end_rate = values_of(end_rate);
+
+    // e_w = h (η₀ F(w) + Σ ηᵢ Fᵢ + η_{s+1} F(w⁺))
+    auto darboux_error = [&]() {
+      W error = S(h * eta[0]) * start_rate + S(h * eta[Stages + 1]) * end_rate;
+      for (int i = 0; i < Stages; ++i) error += S(h * eta[i + 1]) * stage_rates[i];
+      return error;
+    };
+    W e_w = darboux_error();
+    double eta_sum = 0.0;
+    for (int i = 0; i < Stages; ++i) eta_sum += std::abs(eta[i + 1]);
+    const double stale_bound = 4.0 * eta_sum * last_stage_change;
+    const double size = values_of(e_w).cwiseAbs().maxCoeff();
+    const double round_off = 64.0 * std::numeric_limits<double>::epsilon() *
+                             std::max(1.0, values_of(w).cwiseAbs().maxCoeff());
+    if (!(stale_bound <= std::max(0.1 * size, round_off))) {
+      for (int i = 0; i < Stages; ++i) {
+        stage_rates[i] = system.darboux_rates(W(w + increments[i]), S(stage_times[i]));
+        ++statistics.rhs_evaluations;
+      }
+      e_w = darboux_error();
+    }
+
+    // e_z: through the chart (linear: directly; else z⁺ − D⁻¹(w⁺ − e_w)).
+    W e_z;
+    if constexpr (collocation_detail::LinearChart<System>::value) {
+      e_z = system.from_darboux(e_w, S(t_next));
+    } else {
+      e_z = z_next - system.from_darboux(W(w_next - e_w), S(t_next));
+    }
+    Y e_y = Y::Constant(S(0.0));
+    if constexpr (System::kPassiveDimension > 0) {
+      const Y start_passive_rate = passive_coordinate_rates(system, z_start, y_start, S(t));
+      const Y end_passive_rate = passive_coordinate_rates(system, z_next, y_next, S(t_next));
+      statistics.passive_evaluations += 2;
+      e_y = S(h * eta[0]) * start_passive_rate + S(h * eta[Stages + 1]) * end_passive_rate;
+      for (int i = 0; i < Stages; ++i) e_y += S(h * eta[i + 1]) * passive_rates[i];
+    }
+    if (error_sum != nullptr) {
+      error_sum->z += e_z;
+      error_sum->y += e_y;
+    } else {
+      record_local_error_estimate(statistics, local_error_norm<System, S>(z_start, y_start, e_z, e_y));
+    }
   }
 
   /// Extrapolating over many steps' length, or through coincident times, is worse than one explicit
@@ -388,7 +532,8 @@ class GaussCollocation {
   /// Solves Zᵢ = r + h Σⱼ aᵢⱼ F(w + Zⱼ, tⱼ) for the stage increments in place by simplified Newton,
   /// Z ← Z − (I − h A ⊗ J)⁻¹ G(Z), G(Z) = Z − r − h (A ⊗ I) F(w + Z), with J from the memory (kept
   /// across steps while the iteration contracts fast; refreshed when it does not). Leaves in
-  /// `stage_rates` the F of the last evaluation. Returns the iterations taken.
+  /// `stage_rates` the F of the last evaluation and in `last_stage_change` the largest |ΔZ| of the
+  /// final update. Returns the iterations taken.
   ///
   /// Stop (per component k of w, cyclic ones excluded; Dₖ the largest stage change of the iteration):
   /// all Dₖ = 0; or (doubles) each Dₖ shrinking with a predicted next change Dₖ²/Dₖ_prev below 1 % of
@@ -398,7 +543,8 @@ class GaussCollocation {
   int solve_stages(const System& system, const GaussLegendreTableau& tableau, const StateVector<System, S>& w,
                    const StateVector<System, S>& w_remainder, const std::array<double, Stages>& stage_times,
                    double t, double h, Stages_<System, S>& increments, Stages_<System, S>& stage_rates,
-                   CollocationMemory<System, Stages>& memory, StepStatistics& statistics) const {
+                   CollocationMemory<System, Stages>& memory, StepStatistics& statistics,
+                   double& last_stage_change) const {
     constexpr int n = System::kDimension;
     constexpr unsigned kCyclic = collocation_detail::CyclicMask<System>::value;
     // A stop with the predicted next change just under half an ulp leaves an error of one sign every
@@ -456,6 +602,7 @@ class GaussCollocation {
           increments[i](k) = updated;
         }
       }
+      last_stage_change = *std::max_element(change.begin(), change.end());
       for (int k = 0; k < n; ++k) {
         if (kCyclic & (1u << k)) continue;
         if (!std::isfinite(change[k])) fail("met a non-finite stage value", t, iterations);
@@ -523,12 +670,13 @@ class GaussCollocation {
   }
 
   /// Yᵢ = y + r + h Σ aᵢⱼ Gⱼ by sweeps (exact after depth + 1 when the system states its coupling
-  /// depth), then y⁺ = y + (r + h Σ bⱼ Gⱼ) compensated.
+  /// depth), then y⁺ = y + (r + h Σ bⱼ Gⱼ) compensated. Leaves the final Gⱼ in `passive_rates`.
   template <class System, class S>
   void passive_quadrature(const System& system, const GaussLegendreTableau& tableau,
                           const std::array<StateVector<System, S>, Stages>& stage_points,
                           const std::array<double, Stages>& stage_times, double h, PassiveVector<System, S>& y,
-                          PassiveVector<System, S>& y_remainder, StepStatistics& statistics) const {
+                          PassiveVector<System, S>& y_remainder, std::array<PassiveVector<System, S>, Stages>& passive_rates,
+                          StepStatistics& statistics) const {
     using Y = PassiveVector<System, S>;
     if constexpr (System::kPassiveDimension == 0) {
       return;
@@ -536,7 +684,6 @@ class GaussCollocation {
       constexpr int kDepth = collocation_detail::PassiveCouplingDepth<System>::value;
       constexpr int kMaxSweeps = 50;
       std::array<Y, Stages> passive_stages;
-      std::array<Y, Stages> passive_rates;
       passive_stages.fill(y);
       for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
         for (int j = 0; j < Stages; ++j) {

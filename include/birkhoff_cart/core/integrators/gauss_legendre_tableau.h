@@ -24,6 +24,18 @@ struct GaussLegendreTableau {
   /// dᵢ = (bᵀA⁻¹)ᵢ: w⁺ = w + Σ dᵢ Zᵢ with the stage increments Zᵢ = Wᵢ − w = h Σⱼ aᵢⱼ Fⱼ, which needs no
   /// evaluation of F at the converged stages (eq. (B.33); Hairer–Wanner II §IV.8) [-].
   std::array<double, kMaxGaussStages> increment_weights{};
+  /// The embedded solution's weights b̂ on the s + 2 nodes {0, c₁ … c_s, 1} (eq. (B.36)):
+  /// ŵ = w + h (b̂₀ F(w, tₖ) + Σᵢ b̂ᵢ Fᵢ + b̂_{s+1} F(w⁺, tₖ₊₁)), exact for polynomials of degree ≤ s
+  /// (order s + 1; for s = 1 Simpson's rule, exact to degree 3). The endpoint weights are
+  /// b̂₀ = β, b̂_{s+1} = (−1)^{s+1} β with β = 1/((s+1)(s+2)), the (s+2)-point Lobatto rule's endpoint
+  /// weight on [0, 1]; b̂ᵢ = bᵢ − β (ℓᵢ(0) + (−1)^{s+1} ℓᵢ(1)). (The interpolatory rule on these
+  /// nodes is the Gauss rule itself for s ≥ 2, b̂₀ = b̂_{s+1} = 0, and would estimate nothing.) [-]
+  std::array<double, kMaxGaussStages + 2> embedded_weights{};
+  /// ηⱼ with e = w⁺ − ŵ = h Σⱼ ηⱼ F(node j) on the same s + 2 nodes: η₀ = −b̂₀, ηᵢ = bᵢ − b̂ᵢ,
+  /// η_{s+1} = −b̂_{s+1}, computed without cancellation. Σ ηⱼ p(τⱼ) = 0 for every polynomial p of
+  /// degree ≤ s, so e = −h β (δ(0) + (−1)^{s+1} δ(1)) with δ(τ) = u'(τ) − F(u(τ)) the collocation
+  /// polynomial's defect at the step's ends (eq. (B.37)) [-].
+  std::array<double, kMaxGaussStages + 2> estimate_weights{};
 };
 
 /// The tableau with `stages` = 1 … 4 stages; throws std::invalid_argument otherwise.
