@@ -203,9 +203,11 @@ TEST(BirkhoffianEstimate, OnlyObservesTheTrajectoryIsTheSameBitForBitWithItOnOrO
       EXPECT_FALSE(has_local_error_estimate(without)) << integrator;
       EXPECT_EQ(with.newton_iterations_total, without.newton_iterations_total) << integrator;
       EXPECT_GT(with.rhs_evaluations, without.rhs_evaluations) << integrator;
-      std::printf("%-15s %-19s rhs evaluations per step: estimate on %.3f, off %.3f\n", scene_name,
+      std::printf("%-15s %-19s per step, estimate on / off: rhs %.3f / %.3f, passive %.3f / %.3f\n", scene_name,
                   integrator.c_str(), static_cast<double>(with.rhs_evaluations) / 60.0,
-                  static_cast<double>(without.rhs_evaluations) / 60.0);
+                  static_cast<double>(without.rhs_evaluations) / 60.0,
+                  static_cast<double>(with.passive_evaluations) / 60.0,
+                  static_cast<double>(without.passive_evaluations) / 60.0);
     }
   }
 }

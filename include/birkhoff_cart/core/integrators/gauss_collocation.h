@@ -34,8 +34,8 @@
 // collocation polynomial's defect at the step's ends. s = 1: Simpson against the midpoint rule, the
 // classical O(h³) estimate of its own error (within a factor 3 of the true local error on the paper
 // case); s ≥ 2: O(h^{s+2}), a conservative bound of the O(h^{2s+1}) error. The same on g for the
-// passive coordinates. Cost: one rhs evaluation F(w⁺) (first same as last: it is the next step's
-// F(w)) and two passive evaluations a step. It vanishes identically on linear autonomous ẇ = Lw
+// passive coordinates. Cost: one rhs evaluation F(w⁺) and one passive evaluation g(z⁺, y⁺) a step
+// (first same as last: they are the next step's F(w) and g(z, y)). It vanishes identically on linear autonomous ẇ = Lw
 // (the defect is then a multiple of the node polynomial, whose end values cancel).
 #pragma once
 
@@ -126,6 +126,8 @@ struct CollocationMemory {
   double end_time = 0.0;                                                     ///< tₖ₊₁ [s]
   StateVector<System, double> end_point = StateVector<System, double>::Zero();  ///< w⁺
   StateVector<System, double> end_rate = StateVector<System, double>::Zero();   ///< F(w⁺, tₖ₊₁)
+  PassiveVector<System, double> end_passive_point = PassiveVector<System, double>::Zero();  ///< y⁺
+  PassiveVector<System, double> end_passive_rate = PassiveVector<System, double>::Zero();   ///< g(z⁺, y⁺, tₖ₊₁)
 
   void clear() {
     count = 0;
@@ -142,6 +144,14 @@ struct CollocationMemory {
     if (!end_rate_valid || !(std::abs(t - end_time) <= kRoundOff * std::max(1.0, std::abs(t)))) return false;
     for (int k = 0; k < kDimension; ++k) {
       if (!(std::abs(w(k) - end_point(k)) <= kRoundOff * std::abs(end_point(k)))) return false;
+    }
+    return true;
+  }
+  /// The same for the passive rate g(z⁺, y⁺, tₖ₊₁), given that the Birkhoffian part belongs.
+  bool end_passive_rate_belongs_to(const PassiveVector<System, double>& y) const {
+    constexpr double kRoundOff = 8.0 * std::numeric_limits<double>::epsilon();
+    for (int k = 0; k < y.size(); ++k) {
+      if (!(std::abs(y(k) - end_passive_point(k)) <= kRoundOff * std::abs(end_passive_point(k)))) return false;
     }
     return true;
   }
@@ -165,7 +175,7 @@ struct CompensatedPoint {
 struct CollocationSettings {
   int max_iterations = 30;  ///< simplified-Newton iterations per step before StepError [-]
   bool compensated = true;  ///< Kahan/TwoSum summation of the update (advance_compensated)
-  /// Record the local error estimate ê (eq. (B.37)): one more rhs evaluation and two passive ones a
+  /// Record the local error estimate ê (eq. (B.37)): one more rhs evaluation and one passive one a
   /// step; observes only (the trajectory is the same bit for bit either way).
   bool estimate_local_error = true;
 };
@@ -290,7 +300,8 @@ class GaussCollocation {
       start_rate = rate;
       have_start_rate = true;
     }
-    if (estimate && !have_start_rate && memory.end_rate_belongs_to(values_of(w), t)) {
+    const bool continues_last_step = estimate && memory.end_rate_belongs_to(values_of(w), t);
+    if (continues_last_step && !have_start_rate) {
       start_rate = memory.end_rate.template cast<S>();  // first same as last
       have_start_rate = true;
     }
@@ -323,7 +334,8 @@ class GaussCollocation {
         ++statistics.rhs_evaluations;
       }
       estimate_local_error(system, tableau, w, start_rate, w_next, increments, stage_rates, last_stage_change,
-                           stage_times, z_start, y_start, z, y, passive_rates, t, h, memory, statistics, error_sum);
+                           stage_times, z_start, y_start, z, y, passive_rates, continues_last_step, t, h, memory,
+                           statistics, error_sum);
     } else {
       memory.forget_end_rate();
     }
@@ -352,7 +364,8 @@ class GaussCollocation {
                             double last_stage_change, const std::array<double, Stages>& stage_times,
                             const StateVector<System, S>& z_start, const PassiveVector<System, S>& y_start,
                             const StateVector<System, S>& z_next, const PassiveVector<System, S>& y_next,
-                            const std::array<PassiveVector<System, S>, Stages>& passive_rates, double t, double h,
+                            const std::array<PassiveVector<System, S>, Stages>& passive_rates,
+                            bool continues_last_step, double t, double h,
                             CollocationMemory<System, Stages>& memory, StepStatistics& statistics,
                             LocalErrorVectors<System, S>* error_sum) const {
     using W = StateVector<System, S>;
@@ -396,9 +409,17 @@ class GaussCollocation {
     }
     Y e_y = Y::Constant(S(0.0));
     if constexpr (System::kPassiveDimension > 0) {
-      const Y start_passive_rate = passive_coordinate_rates(system, z_start, y_start, S(t));
+      Y start_passive_rate;  // g(z, y, tₖ): first same as last too, while y is the last step's y⁺
+      if (continues_last_step && memory.end_passive_rate_belongs_to(values_of(y_start))) {
+        start_passive_rate = memory.end_passive_rate.template cast<S>();
+      } else {
+        start_passive_rate = passive_coordinate_rates(system, z_start, y_start, S(t));
+        ++statistics.passive_evaluations;
+      }
       const Y end_passive_rate = passive_coordinate_rates(system, z_next, y_next, S(t_next));
-      statistics.passive_evaluations += 2;
+      ++statistics.passive_evaluations;
+      memory.end_passive_point = values_of(y_next);
+      memory.end_passive_rate = values_of(end_passive_rate);
       e_y = S(h * eta[0]) * start_passive_rate + S(h * eta[Stages + 1]) * end_passive_rate;
       for (int i = 0; i < Stages; ++i) e_y += S(h * eta[i + 1]) * passive_rates[i];
     }
