@@ -199,6 +199,8 @@ TEST_F(Cli, EveryMalformedSceneExitsThreeWithOneLineNamingFileAndKey) {
       {"negative_duration", edited("duration: 0.5", "duration: -5.0"), "duration"},
       {"bad_form", edited("  step_size: 0.01\n", "  step_size: 0.01\n  birkhoffian_form: hamiltonian\n"),
        "integrator.birkhoffian_form"},
+      {"bad_estimate_switch", edited("  step_size: 0.01\n", "  step_size: 0.01\n  local_error_estimate: sometimes\n"),
+       "integrator.local_error_estimate"},
       {"three_wheel_angles", edited("  steering_rate: 0.3\n", "  steering_rate: 0.3\n  wheel_spin_angles: [0, 0, 0]\n"),
        "initial_state.wheel_spin_angles"},
       {"zero_output_rate", std::string(kMinimalScene) + "output_rate: 0\n", "output_rate"},
