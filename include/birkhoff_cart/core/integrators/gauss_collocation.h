@@ -360,7 +360,7 @@ class GaussCollocation {
   template <class System, class S>
   void estimate_local_error(const System& system, const GaussLegendreTableau& tableau, const StateVector<System, S>& w,
                             const StateVector<System, S>& start_rate, const StateVector<System, S>& w_next,
-                            const Stages_<System, S>& increments, Stages_<System, S>& stage_rates,
+                            const Stages_<System, S>& increments, const Stages_<System, S>& stage_rates,
                             double last_stage_change, const std::array<double, Stages>& stage_times,
                             const StateVector<System, S>& z_start, const PassiveVector<System, S>& y_start,
                             const StateVector<System, S>& z_next, const PassiveVector<System, S>& y_next,
@@ -380,12 +380,12 @@ class GaussCollocation {
     memory.end_rate = values_of(end_rate);
 
     // e_w = h (η₀ F(w) + Σ ηᵢ Fᵢ + η_{s+1} F(w⁺))
-    auto darboux_error = [&]() {
+    auto darboux_error = [&](const Stages_<System, S>& rates) {
       W error = S(h * eta[0]) * start_rate + S(h * eta[Stages + 1]) * end_rate;
-      for (int i = 0; i < Stages; ++i) error += S(h * eta[i + 1]) * stage_rates[i];
+      for (int i = 0; i < Stages; ++i) error += S(h * eta[i + 1]) * rates[i];
       return error;
     };
-    W e_w = darboux_error();
+    W e_w = darboux_error(stage_rates);
     double eta_sum = 0.0;
     for (int i = 0; i < Stages; ++i) eta_sum += std::abs(eta[i + 1]);
     const double stale_bound = 4.0 * eta_sum * last_stage_change;
@@ -393,11 +393,14 @@ class GaussCollocation {
     const double round_off = 64.0 * std::numeric_limits<double>::epsilon() *
                              std::max(1.0, values_of(w).cwiseAbs().maxCoeff());
     if (!(stale_bound <= std::max(0.1 * size, round_off))) {
+      // A copy: the memory keeps the solve's own rates, so that the next step's starting values (and
+      // with them the trajectory, bit for bit) do not depend on whether the estimate is on.
+      Stages_<System, S> converged_rates;
       for (int i = 0; i < Stages; ++i) {
-        stage_rates[i] = system.darboux_rates(W(w + increments[i]), S(stage_times[i]));
+        converged_rates[i] = system.darboux_rates(W(w + increments[i]), S(stage_times[i]));
         ++statistics.rhs_evaluations;
       }
-      e_w = darboux_error();
+      e_w = darboux_error(converged_rates);
     }
 
     // e_z: through the chart (linear: directly; else z⁺ − D⁻¹(w⁺ − e_w)).
