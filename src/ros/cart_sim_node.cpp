@@ -57,11 +57,23 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
                            " s: cart_sim publishes scene time as ROS time, which must be >= 0");
   }
   if (parameters_.duration < 0.0) {
-    end_time_ = simulation_->end_time();
+    run_duration_ = simulation_->scene().duration;
   } else if (parameters_.duration == 0.0 || std::isinf(parameters_.duration)) {
-    end_time_ = std::numeric_limits<double>::infinity();
+    run_duration_ = std::numeric_limits<double>::infinity();
   } else {
-    end_time_ = start_time + parameters_.duration;
+    run_duration_ = parameters_.duration;
+  }
+  end_time_ = std::numeric_limits<double>::infinity();
+  if (std::isfinite(run_duration_)) {
+    // The same plan as cart_simulate's (the scene's own duration was already checked by Simulation).
+    try {
+      end_time_ = plan_steps(start_time, run_duration_, simulation_->step_size()).end_time;
+    } catch (const TimeLimitError& error) {
+      const bool from_parameter = parameters_.duration > 0.0 && error.key() == "duration";
+      const std::string key = from_parameter ? std::string("~duration") : "scene key '" + error.key() + "'";
+      throw NodeStartupError("the run of scene " + parameters_.scene_path + " cannot be cut into steps: " + key +
+                             ": " + error.problem());
+    }
   }
   // ros::Time holds 32-bit seconds: a stamp at or past 2^32 s throws in roscpp. Refuse such a run
   // here by name; a run without end that gets there stops cleanly with exit 4 (run()).
@@ -183,15 +195,27 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
 CartSimNode::~CartSimNode() = default;
 
 void CartSimNode::restart_schedule() {
+  // Simulation::step() lands on t0 + n h counted from the scene's start; the plan's grid is the same
+  // only when made at step 0, which construction and reset() guarantee.
+  if (simulation_->steps_taken() != 0) {
+    throw std::logic_error("cart_sim: the run's schedule is planned only at the scene's start");
+  }
+  const double start_time = simulation_->state().time;
+  if (std::isfinite(run_duration_)) schedule_ = plan_steps(start_time, run_duration_, simulation_->step_size());
   next_publish_index_ = 1;
   next_diagnostic_index_ = 1;
   clock_started_ = false;
   last_transform_stamp_ = ros::Time();
-  pacing_.restart(WallClockPacing::Clock::now(), simulation_->state().time);
+  pacing_.restart(WallClockPacing::Clock::now(), start_time);
 }
 
 bool CartSimNode::end_reached() const {
-  return simulation_->state().time + 0.5 * simulation_->step_size() > end_time_;
+  return schedule_ && simulation_->steps_taken() >= schedule_->total_steps();
+}
+
+double CartSimNode::next_step_time() const {
+  if (schedule_ && simulation_->steps_taken() >= schedule_->whole_steps) return schedule_->end_time;
+  return simulation_->state().time + simulation_->step_size();
 }
 
 bool CartSimNode::stop_requested() const { return shutdown_signal_received() || !ros::ok(); }
@@ -200,7 +224,12 @@ bool CartSimNode::take_step() {
   apply_watchdogs();
   const double time_before = simulation_->state().time;
   try {
-    simulation_->step();
+    // Whole steps onto t0 + n h, then the schedule's final step onto the end time exactly.
+    if (schedule_ && simulation_->steps_taken() >= schedule_->whole_steps) {
+      simulation_->step_to(schedule_->end_time);
+    } else {
+      simulation_->step();
+    }
   } catch (const StepError& error) {
     step_failure_ = error.what();
     return false;
@@ -208,11 +237,12 @@ bool CartSimNode::take_step() {
   ++period_steps_;
   ++total_steps_;
   simulated_time_ += simulation_->state().time - time_before;
-  if (!clock_started_) {  // the first /clock, t0 + h, unless that is a publish instant (published there)
+  if (!clock_started_) {  // the first /clock, t0 + h, unless that is a publish instant or the end (published there)
     clock_started_ = true;
     const double start = simulation_->scene().initial_state.time;
     const double time = simulation_->state().time;
-    if (start + static_cast<double>(next_publish_index_) * publish_period_ > time + 0.5 * simulation_->step_size()) {
+    if (!end_reached() &&
+        start + static_cast<double>(next_publish_index_) * publish_period_ > time + 0.5 * simulation_->step_size()) {
       publish_clock(time);
     }
   }
@@ -251,7 +281,7 @@ int CartSimNode::run_loop(std::string& outcome) {
       // Real time: a step is due once the wall clock has reached its scene time (half a step early
       // is fine). Steps due are run back to back; only a node that has caught up runs callbacks or
       // sleeps, so a command takes effect at the first step after its arrival in scene time too.
-      const double next_time = simulation_->state().time + simulation_->step_size();
+      const double next_time = next_step_time();
       // The scene time due by now is read from the clock only when the last reading no longer
       // covers the next step (one clock read per catch-up, not per step).
       if (pacing_.paced() && due_scene_time < next_time - half_step) {
@@ -290,7 +320,9 @@ int CartSimNode::run_loop(std::string& outcome) {
     if (failed) break;
     if (interrupted) continue;
     const double time = simulation_->state().time;
-    if (pass_due_instants(start, publish_period_, time, half_step, next_publish_index_)) {
+    // The publish instants due by now, and the run's end t0 + T (an instant or not), published once.
+    const bool instant_due = pass_due_instants(start, publish_period_, time, half_step, next_publish_index_);
+    if (instant_due || end_reached()) {
       publish_clock(time);
       publish_instant();
       if (record_failure_) break;

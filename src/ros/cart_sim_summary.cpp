@@ -3,6 +3,7 @@
 #include "birkhoff_cart/ros/accuracy_reporting.h"
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -10,6 +11,16 @@
 #include <sstream>
 
 namespace birkhoff_cart {
+namespace {
+
+/// The shortest decimal text that reads back as exactly `value` (t0 + T = 5.6960000000005, not 5.696).
+std::string exact_text(double value) {
+  char buffer[32];
+  const std::to_chars_result result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return std::string(buffer, result.ptr);
+}
+
+}  // namespace
 
 void CartSimNode::produce_diagnostics(diagnostic_updater::DiagnosticStatusWrapper& status) {
   const Diagnostics diagnostics = simulation_->diagnostics();
@@ -85,9 +96,8 @@ void CartSimNode::produce_diagnostics(diagnostic_updater::DiagnosticStatusWrappe
   add_channel("drive_torque", drive_channel_);
 }
 
-double CartSimNode::real_time_factor() const {
-  const double running_wall_time =
-      std::chrono::duration<double>(WallClockPacing::Clock::now() - run_start_wall_).count() - paused_wall_time_;
+double CartSimNode::real_time_factor(WallClockPacing::Clock::time_point now) const {
+  const double running_wall_time = std::chrono::duration<double>(now - run_start_wall_).count() - paused_wall_time_;
   return running_wall_time > 0.0 ? simulated_time_ / running_wall_time : 0.0;
 }
 
@@ -95,11 +105,14 @@ void CartSimNode::write_summary(const std::string& outcome) {
   const CartState& state = simulation_->state();
   const Diagnostics diagnostics = simulation_->diagnostics();
   const Eigen::Vector2d rear_axle_midpoint = simulation_->model().rear_axle_midpoint(state);
-  const double wall_time = std::chrono::duration<double>(WallClockPacing::Clock::now() - run_start_wall_).count();
+  // One clock reading for the wall time and the real-time factor, so the summary's numbers agree
+  // with each other (two readings drifted apart by more than 1e-3 of a short run under load).
+  const WallClockPacing::Clock::time_point now = WallClockPacing::Clock::now();
+  const double wall_time = std::chrono::duration<double>(now - run_start_wall_).count();
   std::ostringstream text;
   text << std::setprecision(9);
   text << "cart_sim summary: " << outcome << ". Scene '" << simulation_->scene().name << "', integrator "
-       << simulation_->integrator_name() << ", h = " << simulation_->step_size() << " s, final t = " << state.time
+       << simulation_->integrator_name() << ", h = " << simulation_->step_size() << " s, final t = " << exact_text(state.time)
        << " s. Final pose of base_link (rear-axle midpoint A): x = " << rear_axle_midpoint.x()
        << " m, y = " << rear_axle_midpoint.y() << " m, theta = " << state.heading
        << " rad. Energy T* = " << diagnostics.energy << " J, energy-balance residual = "
@@ -110,7 +123,7 @@ void CartSimNode::write_summary(const std::string& outcome) {
   }
   text << ". Steps: " << total_steps_ << " (" << simulation_->statistics().newton_iterations_total
        << " Newton iterations since the last start), wall time " << wall_time << " s (stepping "
-       << stepping_wall_time_ << " s, paused " << paused_wall_time_ << " s), real-time factor " << real_time_factor()
+       << stepping_wall_time_ << " s, paused " << paused_wall_time_ << " s), real-time factor " << real_time_factor(now)
        << ". Published instants: " << published_instants_ << "."
        << ros_accuracy::summary_sentence(accuracy_guard_, simulation_->statistics(), simulation_->integrator_name());
   if (parameters_.lockstep) text << " Lockstep timeouts: " << lockstep_timeouts_ << ".";

@@ -4,7 +4,9 @@
 //
 // Time: the node steps the simulation and publishes /clock itself (run with /use_sim_time true);
 // message stamps are the scene's time t (scene time t is ROS time t). The first /clock is one step
-// after the start (t0 + h), never 0. Three ways to run (README.md, "Running modes"):
+// after the start (t0 + h), never 0. A run with an end is cut into steps by the rule that
+// cart_simulate uses (step_schedule.h): whole steps on t0 + n h, then one landing step exactly on
+// t0 + T, which is published as the run's last instant. Three ways to run (README.md, "Running modes"):
 //  - fast: as fast as possible (or at ~real_time_factor). Callbacks run at the first step after the
 //    transport queued them (SignalingCallbackQueue's flag, one atomic load per step).
 //  - real time: paced by absolute wall-clock deadlines (WallClockPacing); the node sleeps until the
@@ -85,10 +87,15 @@ class CartSimNode {
   void open_record(const std::string& path);
 
   // cart_sim_node.cpp
+  /// Plans the run from the current state (construction, ~reset: the simulation's step count is 0)
+  /// and restarts the publish instants and the pacing there.
   void restart_schedule();
   void apply_watchdogs();
+  /// True once the run's schedule is done: the state is at end_time_ exactly (never without an end).
   bool end_reached() const;
-  /// One step (watchdogs first); false when it failed (step_failure_ set).
+  /// The scene time the next step lands on: t + h, or the end time for the schedule's final step [s].
+  double next_step_time() const;
+  /// The next step of the run's schedule (watchdogs first); false when it failed (step_failure_ set).
   bool take_step();
 
   // cart_sim_publishing.cpp
@@ -119,8 +126,8 @@ class CartSimNode {
   /// of the run done and the real-time factor since the last line.
   void report_progress();
   void write_summary(const std::string& outcome);
-  /// Real-time factor over the run: scene time advanced / wall time not paused [-].
-  double real_time_factor() const;
+  /// Real-time factor over the run until `now`: scene time advanced / wall time not paused [-].
+  double real_time_factor(WallClockPacing::Clock::time_point now = WallClockPacing::Clock::now()) const;
 
   ros::NodeHandle node_;
   ros::NodeHandle private_node_;
@@ -145,7 +152,9 @@ class CartSimNode {
   std::unique_ptr<tf2_ros::TransformBroadcaster> transform_broadcaster_;
   std::unique_ptr<diagnostic_updater::Updater> diagnostic_updater_;
 
-  double end_time_ = 0.0;                 ///< scene time at which the run stops [s]; +inf = never
+  double run_duration_ = 0.0;             ///< T: the run's length from its start [s]; +inf = without end
+  std::optional<StepSchedule> schedule_;  ///< how the run is cut into steps (step_schedule.h); none without end
+  double end_time_ = 0.0;                 ///< t0 + T, where the run stops exactly [s]; +inf = never
   double publish_period_ = 0.01;          ///< [s]
   WallClockPacing pacing_;
   std::uint64_t next_publish_index_ = 1;  ///< k of the next publish instant t0 + k/publish_rate
