@@ -123,7 +123,8 @@ void CartSimNode::write_summary(const std::string& outcome) {
   }
   text << ". Steps: " << total_steps_ << " (" << simulation_->statistics().newton_iterations_total
        << " Newton iterations since the last start), wall time " << wall_time << " s (stepping "
-       << stepping_wall_time_ << " s, paused " << paused_wall_time_ << " s), real-time factor " << real_time_factor(now)
+       << stepping_wall_time_ << " s, paused " << paused_wall_time_
+       << " s), real-time factor " << real_time_factor(now)
        << ". Published instants: " << published_instants_ << "."
        << ros_accuracy::summary_sentence(accuracy_guard_, simulation_->statistics(), simulation_->integrator_name());
   if (parameters_.lockstep) text << " Lockstep timeouts: " << lockstep_timeouts_ << ".";

@@ -15,6 +15,7 @@
 
 #include "birkhoff_cart/core/version.h"
 #include "birkhoff_cart/ros/cart_sim_node.h"
+#include "birkhoff_cart/ros/node_main.h"
 
 namespace {
 
@@ -51,26 +52,29 @@ int run_node(ros::NodeHandle& node_handle) {
 
 int main(int argc, char** argv) {
   if (birkhoff_cart::print_version_if_asked(argc, argv, "cart_sim")) return 0;
-  // Log lines reach a file (roslaunch output="log", a redirect) as they happen, not at exit.
-  std::setvbuf(stdout, nullptr, _IOLBF, 0);
-  // roscpp subscribes every process to /clock under sim time; the clock source would hear back
-  // each /clock it publishes (a thread wake-up each, ~1 µs per step in fast mode). Remap that
-  // internal subscription away; CartSimNode publishes on the real /clock and sets its own time.
-  std::vector<char*> arguments(argv, argv + argc);
-  std::string unheard_clock = std::string("/clock:=") + birkhoff_cart::kUnheardClockTopic;
-  arguments.push_back(unheard_clock.data());
-  int argument_count = static_cast<int>(arguments.size());
-  ros::init(argument_count, arguments.data(), "cart_sim", ros::init_options::NoSigintHandler);
-  birkhoff_cart::install_shutdown_signal_handlers();
-  // Outlives the node: when the last NodeHandle dies roscpp shuts down and drops later log output,
-  // so the FATAL message below would be lost.
-  ros::NodeHandle node_handle;
-  const int exit_code = run_node(node_handle);
-  bool end_launch = false;
-  ros::param::get("~end_launch", end_launch);
-  if (end_launch && exit_code == birkhoff_cart::CartSimNode::kExitFinished &&
-      !birkhoff_cart::shutdown_signal_received()) {
-    end_parent_launch();
-  }
-  return exit_code;
+  // ros::init refuses a bad name or remapping by throwing: exit 2 with its message (node_main.h).
+  return birkhoff_cart::run_node_main("cart_sim", [&] {
+    // Log lines reach a file (roslaunch output="log", a redirect) as they happen, not at exit.
+    std::setvbuf(stdout, nullptr, _IOLBF, 0);
+    // roscpp subscribes every process to /clock under sim time; the clock source would hear back
+    // each /clock it publishes (a thread wake-up each, ~1 µs per step in fast mode). Remap that
+    // internal subscription away; CartSimNode publishes on the real /clock and sets its own time.
+    std::vector<char*> arguments(argv, argv + argc);
+    std::string unheard_clock = std::string("/clock:=") + birkhoff_cart::kUnheardClockTopic;
+    arguments.push_back(unheard_clock.data());
+    int argument_count = static_cast<int>(arguments.size());
+    ros::init(argument_count, arguments.data(), "cart_sim", ros::init_options::NoSigintHandler);
+    birkhoff_cart::install_shutdown_signal_handlers();
+    // Outlives the node: when the last NodeHandle dies roscpp shuts down and drops later log output,
+    // so the FATAL message below would be lost.
+    ros::NodeHandle node_handle;
+    const int exit_code = run_node(node_handle);
+    bool end_launch = false;
+    ros::param::get("~end_launch", end_launch);
+    if (end_launch && exit_code == birkhoff_cart::CartSimNode::kExitFinished &&
+        !birkhoff_cart::shutdown_signal_received()) {
+      end_parent_launch();
+    }
+    return exit_code;
+  });
 }

@@ -1,0 +1,63 @@
+// rostest node_mains: regression of issue 17 ("no exception escapes main of any executable").
+// ros::init, NodeHandle, advertise and subscribe throw ros::InvalidNameException for a node name,
+// namespace or remapping roscpp refuses; every node let it escape main (std::terminate, exit 134,
+// no line of its own). steering_driver's timer threw std::runtime_error for ~rate 1e-12 Hz (a
+// period beyond ros::Duration's 2^31 s). Each must now end with exit 2 and a line naming the problem.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include <ros/ros.h>
+
+#include "test_helpers.h"
+
+namespace {
+
+using birkhoff_cart_test::package_executable;
+using birkhoff_cart_test::run_command;
+
+const std::vector<std::string> kNodes = {"cart_sim", "cmd_vel_controller", "steering_driver",
+                                         "steering_pd_controller"};
+
+/// Runs the package's `node` with `arguments` (shell-quoted here) and returns its exit status.
+int run_node(const std::string& node, const std::string& arguments, std::string* output) {
+  return run_command("timeout 60 " + package_executable(node) + " " + arguments, output);
+}
+
+TEST(NodeMains, EveryNodeRefusesAnInvalidNameWithExit2) {
+  // A bad node name, a bad namespace, a remapping to a bad name: each refused in ros::init.
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"'__name:=9cart'", "9cart"}, {"'__ns:=/a!b'", "/a!b"}, {"'joint_states:=a!b'", "a!b"}};
+  for (const std::string& node : kNodes) {
+    for (const auto& [arguments, bad_name] : cases) {
+      std::string output;
+      const int status = run_node(node, arguments, &output);
+      EXPECT_EQ(status, 2) << node << " " << arguments << ":\n" << output;
+      EXPECT_NE(output.find(node + ": refused at start"), std::string::npos) << node << " " << arguments << ":\n"
+                                                                              << output;
+      EXPECT_NE(output.find(bad_name), std::string::npos) << output;
+      EXPECT_EQ(output.find("terminate called"), std::string::npos) << output;
+    }
+  }
+}
+
+TEST(SteeringDriver, RefusesARateItsTimerCannotHold) {
+  for (const std::string& rate : {"1e-12", "inf", "1e9", "0"}) {
+    std::string output;
+    const int status = run_node("steering_driver", "__name:=driver_rate _rate:=" + rate, &output);
+    EXPECT_EQ(status, 2) << "~rate " << rate << ":\n" << output;
+    EXPECT_NE(output.find("~rate must be in"), std::string::npos) << output;
+    EXPECT_EQ(output.find("terminate called"), std::string::npos) << output;
+    ros::NodeHandle().deleteParam("/driver_rate");
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "node_mains");
+  ros::NodeHandle node;
+  return RUN_ALL_TESTS();
+}
