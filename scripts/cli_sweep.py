@@ -29,7 +29,9 @@ import time
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENE_DIR = os.path.join(REPO, "config", "scenes")
-INTEGRATORS = ["birkhoff2", "birkhoff4", "rk2", "rk4", "dopri5", "midpoint"]
+# Every registry member (cart_simulate --help), the default scene's birkhoff_gauss4 included.
+INTEGRATORS = ["birkhoff2", "birkhoff4", "birkhoff_gauss4", "birkhoff_gauss6", "birkhoff_gauss8", "birkhoff4_suzuki",
+               "birkhoff6_kahan_li", "birkhoff8_kahan_li", "rk2", "rk4", "dopri5", "midpoint"]
 STEPS = [1e-4, 2e-4, 2.5e-4, 5e-4, 1e-3, 2e-3, 2.5e-3, 5e-3, 1e-2, 2e-2]  # h [s]
 TIME_LINE = re.compile(r"^(  time:\s*)(\S+)(.*)$", re.M)
 
