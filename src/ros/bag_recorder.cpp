@@ -8,7 +8,6 @@
 #include <cstring>
 #include <stdexcept>
 
-#include <rosbag/exceptions.h>
 
 namespace birkhoff_cart {
 
@@ -57,16 +56,16 @@ BagRecorder::BagRecorder(const std::string& path, Compression compression, std::
     const std::string shortage = disk_space_shortage(directory, free_bytes, min_free_disk_space);
     if (!shortage.empty()) throw BagRecorderError("cannot record to " + path + ": " + shortage);
   }
-  bag_ = std::make_unique<rosbag::Bag>();
-  try {
-    bag_->open(active_path(), rosbag::bagmode::Write);
-  } catch (const rosbag::BagException& error) {
-    throw BagRecorderError("cannot open bag " + active_path() + " for writing: " + error.what());
-  }
+  BagFileWriter::Compression file_compression = BagFileWriter::Compression::kLz4;
   switch (compression) {
-    case Compression::kNone: bag_->setCompression(rosbag::compression::Uncompressed); break;
-    case Compression::kLz4: bag_->setCompression(rosbag::compression::LZ4); break;
-    case Compression::kBz2: bag_->setCompression(rosbag::compression::BZ2); break;
+    case Compression::kNone: file_compression = BagFileWriter::Compression::kNone; break;
+    case Compression::kLz4: file_compression = BagFileWriter::Compression::kLz4; break;
+    case Compression::kBz2: file_compression = BagFileWriter::Compression::kBz2; break;
+  }
+  try {
+    bag_ = std::make_unique<BagFileWriter>(active_path(), file_compression);
+  } catch (const BagFileError& error) {
+    throw BagRecorderError("cannot open bag " + active_path() + " for writing: " + error.what());
   }
   open_ = true;
   writer_ = std::thread(&BagRecorder::write_queued, this);
@@ -130,10 +129,7 @@ void BagRecorder::close() {
   try {
     bag_->close();
   } catch (const std::exception& error) {
-    // rosbag::Bag's destructor would retry the same close and throw out of a destructor
-    // (std::terminate). Let the half-closed Bag go instead; process exit closes its file, and the
-    // chunks already written stay in "<path>.active" for `rosbag reindex`.
-    static_cast<void>(bag_.release());
+    // The chunks already written stay in "<path>.active" (unindexed) for `rosbag reindex`.
     throw BagRecorderError("cannot close bag " + active_path() + " (left as it is): " + error.what() +
                            (failure_ ? " (after: " + *failure_ + ")" : std::string()));
   }

@@ -1,4 +1,4 @@
-// The node's own record: a compressed rosbag written through the rosbag C++ API. While open the
+// The node's own record: a compressed rosbag (format 2.0, BagFileWriter). While open the
 // bag is "<path>.active" (like `rosbag record`); close() renames it to <path>, so a bag at <path>
 // is always complete and readable by `rosbag info` and python rosbag.
 //
@@ -6,7 +6,7 @@
 // minimum (cart_sim's ~min_free_disk_space), so a node never starts a record it cannot keep. A disk
 // that fills during the run makes write() (or close()) throw; close() then closes what it can.
 //
-// Threading: rosbag's serialization, LZ4 compression and file calls run on the recorder's own
+// Threading: serialization, compression and file calls (BagFileWriter) run on the recorder's own
 // writer thread. write() copies the message into a bounded ring of reused slots (no allocation in
 // steady state) and returns; when the ring is full it waits for the writer (back pressure: no
 // message is ever dropped). close() drains the ring, closes and renames the bag; the destructor
@@ -27,12 +27,12 @@
 
 #include <nav_msgs/Odometry.h>
 #include <ros/time.h>
-#include <rosbag/bag.h>
 #include <sensor_msgs/JointState.h>
 #include <std_msgs/Float64.h>
 #include <tf2_msgs/TFMessage.h>
 
 #include "birkhoff_cart/IntegrationError.h"
+#include "birkhoff_cart/ros/bag_file_writer.h"
 
 namespace birkhoff_cart {
 
@@ -136,7 +136,7 @@ class BagRecorder {
   std::string free_space_note() const;
 
   std::string path_;
-  std::unique_ptr<rosbag::Bag> bag_;
+  std::unique_ptr<BagFileWriter> bag_;
   bool open_ = false;      ///< accepting writes (mutex_)
   bool finished_ = false;  ///< closed and renamed to path_
 
