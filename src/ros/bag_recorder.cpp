@@ -87,28 +87,36 @@ void BagRecorder::throw_if_unusable() const {
 void BagRecorder::write_queued() {
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {
-    slot_filled_.wait(lock, [this] { return queued_ > 0 || !open_; });
-    if (queued_ == 0) return;  // closed and drained
-    Slot& slot = slots_[next_];
-    if (!failure_) {
-      // The slot is the writer's until released below: the loop fills only free slots.
-      lock.unlock();
-      std::optional<std::string> failed;
+    writer_waiting_ = true;
+    slot_filled_.wait(lock, [this] { return queued_ >= kWakeBatch || (loop_waiting_ && queued_ > 0) || !open_; });
+    writer_waiting_ = false;
+    if (queued_ == 0) return;  // closed and drained (woken with nothing queued only by close())
+    // The queued slots are the writer's until released below: the loop fills only free slots.
+    const std::size_t batch = queued_;
+    const std::size_t first = next_;
+    lock.unlock();
+    std::optional<std::string> failed;
+    for (std::size_t k = 0; k < batch && !failed && !failed_; ++k) {
+      Slot& slot = slots_[(first + k) % slots_.size()];
       try {
         std::visit([&](const auto& message) { bag_->write(slot.topic, slot.time, message); }, slot.message);
       } catch (const std::exception& error) {
         failed = "cannot write " + slot.topic + " to bag " + active_path() + ": " + error.what() + free_space_note();
       }
-      lock.lock();
-      if (failed) {
-        failure_ = failed;
-      } else {
-        ++message_counts_[slot.topic];
-      }
+      if (!failed) ++written_counts_[slot.topic];
     }
-    next_ = (next_ + 1) % slots_.size();
-    --queued_;
-    slot_free_.notify_all();
+    lock.lock();
+    if (failed && !failure_) {
+      failure_ = failed;
+      failed_ = true;
+    }
+    for (auto& [topic, count] : written_counts_) {
+      message_counts_[topic] += count;
+      count = 0;
+    }
+    next_ = (next_ + batch) % slots_.size();  // a failed batch's rest is dropped: the record has failed
+    queued_ -= batch;
+    if (loop_waiting_ || failure_) slot_free_.notify_all();
   }
 }
 

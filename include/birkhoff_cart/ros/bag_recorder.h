@@ -8,8 +8,8 @@
 //
 // Threading: serialization, compression and file calls (BagFileWriter) run on the recorder's own
 // writer thread. write() copies the message into a bounded ring of reused slots (no allocation in
-// steady state) and returns; when the ring is full it waits for the writer (back pressure: no
-// message is ever dropped). close() drains the ring, closes and renames the bag; the destructor
+// steady state) and returns; the writer is woken once per kWakeBatch messages and writes all that
+// are queued; when the ring is full write() waits for it (back pressure: no message is ever dropped). close() drains the ring, closes and renames the bag; the destructor
 // does the same, so every exit path that unwinds the stack leaves a complete bag.
 #pragma once
 
@@ -67,6 +67,8 @@ class BagRecorder {
       std::variant<nav_msgs::Odometry, sensor_msgs::JointState, IntegrationError, std_msgs::Float64, tf2_msgs::TFMessage>;
   /// Slots of the ring between the time loop and the writer thread [messages].
   static constexpr std::size_t kQueueCapacity = 1024;
+  /// Messages queued before the waiting writer thread is woken (close() wakes it for the rest).
+  static constexpr std::size_t kWakeBatch = 256;
 
   /// Opens "<path>.active" for writing and starts the writer thread. Throws BagRecorderError when
   /// it cannot (missing or unwritable directory, empty path, ...) or, with `min_free_disk_space` >
@@ -85,7 +87,13 @@ class BagRecorder {
   template <class M>
   void write(const std::string& topic, const ros::Time& time, const M& message) {
     std::unique_lock<std::mutex> lock(mutex_);
-    slot_free_.wait(lock, [this] { return queued_ < slots_.size() || failure_ || !open_; });
+    if (queued_ == slots_.size() && !failure_ && open_) {
+      // Full: wake the writer whatever the batch, and wait for it (back pressure, never a drop).
+      loop_waiting_ = true;
+      slot_filled_.notify_one();
+      slot_free_.wait(lock, [this] { return queued_ < slots_.size() || failure_ || !open_; });
+      loop_waiting_ = false;
+    }
     throw_if_unusable();
     Slot& slot = slots_[(next_ + queued_) % slots_.size()];
     slot.topic = topic;  // reuses the slot's capacity
@@ -96,8 +104,11 @@ class BagRecorder {
       slot.message = message;
     }
     ++queued_;
+    // The writer is woken once per kWakeBatch messages, not per message: a wake-up (futex, task
+    // switch) cost more than writing the message itself.
+    const bool wake = writer_waiting_ && queued_ >= kWakeBatch;
     lock.unlock();
-    slot_filled_.notify_one();
+    if (wake) slot_filled_.notify_one();
   }
 
   /// Drains the ring, flushes, closes and renames the bag to its final path. Idempotent. Throws
@@ -146,8 +157,13 @@ class BagRecorder {
   std::vector<Slot> slots_;
   std::size_t next_ = 0;    ///< the slot the writer takes next
   std::size_t queued_ = 0;  ///< filled slots not yet written
+  bool writer_waiting_ = false;  ///< the writer sleeps on slot_filled_
+  bool loop_waiting_ = false;    ///< write() sleeps on slot_free_ (ring full)
   std::optional<std::string> failure_;   ///< the writer's first failure
   std::map<std::string, std::uint64_t> message_counts_;
+  // The writer thread's own (no lock): its first failure stops its writes; counts of its batch.
+  bool failed_ = false;
+  std::map<std::string, std::uint64_t> written_counts_;
   std::thread writer_;
 };
 
