@@ -158,7 +158,13 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   } else if (ros::Time::isSimTime()) {
     clock_subscriber_ = clock_node.subscribe("/clock", 1, &hear_clock);
   }
-  if (parameters_.publish_tf) transform_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
+  // /tf through a publisher of our own rather than tf2_ros::TransformBroadcaster, whose
+  // sendTransform() builds a new TFMessage (a vector) at every call; same topic and queue.
+  if (parameters_.publish_tf) transform_publisher_ = ros::NodeHandle().advertise<tf2_msgs::TFMessage>(kTransformTopic, 100);
+  odometry_topic_ = odometry_publisher_.getTopic();
+  joint_state_topic_ = joint_state_publisher_.getTopic();
+  integration_error_topic_ = integration_error_publisher_.getTopic();
+  instant_messages_.emplace(parameters_.frames, parameters_.odometry_covariance);
   // Only the commands the scene takes are subscribed: an idle subscription would be an unconnected
   // one for roswtf, and a command sent to a scene without a command source shows up there as an
   // unconnected publication instead.

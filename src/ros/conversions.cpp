@@ -10,15 +10,13 @@ namespace birkhoff_cart {
 namespace ros_conversions {
 namespace {
 
-geometry_msgs::Quaternion yaw_quaternion(double yaw) {
+void set_yaw_quaternion(geometry_msgs::Quaternion& message, double yaw) {
   tf2::Quaternion rotation;
   rotation.setRPY(0.0, 0.0, yaw);
-  geometry_msgs::Quaternion message;
   message.x = rotation.x();
   message.y = rotation.y();
   message.z = rotation.z();
   message.w = rotation.w();
-  return message;
 }
 
 void set_diagonal(boost::array<double, 36>& covariance, const std::array<double, 6>& variances) {
@@ -58,58 +56,92 @@ FrameNames prefixed_frames(const std::string& prefix, const std::string& odom, c
   return frames;
 }
 
-nav_msgs::Odometry to_odometry(const CartState& state, const CartModel& model, const FrameNames& frames,
-                               const OdometryCovariance& covariance) {
+void fill_odometry(nav_msgs::Odometry& odometry, const CartState& state, const CartModel& model,
+                   const FrameNames& frames, const OdometryCovariance& covariance) {
   const Eigen::Vector2d rear_axle_midpoint = model.rear_axle_midpoint(state);  // A [m]
   const Vector2<double> quasi_velocity(state.forward_speed, state.steering_rate);
   const CoordinateRates<double> rates = model.coordinate_rates(state.heading, state.steering_angle, quasi_velocity);
 
-  nav_msgs::Odometry odometry;
   odometry.header.stamp = to_ros_time(state.time);
-  odometry.header.frame_id = frames.odom;
+  odometry.header.frame_id = frames.odom;  // copy-assignments reuse the strings' capacity
   odometry.child_frame_id = frames.base_link;
   odometry.pose.pose.position.x = rear_axle_midpoint.x();
   odometry.pose.pose.position.y = rear_axle_midpoint.y();
   odometry.pose.pose.position.z = 0.0;
-  odometry.pose.pose.orientation = yaw_quaternion(state.heading);
+  set_yaw_quaternion(odometry.pose.pose.orientation, state.heading);
   set_diagonal(odometry.pose.covariance, covariance.pose_diagonal);
   // v_A = ω1 cos χ along e: A has no lateral speed (eq. (2.3), constraint (15)) [m/s].
   odometry.twist.twist.linear.x = state.forward_speed * std::cos(state.steering_angle);
+  odometry.twist.twist.linear.y = 0.0;
+  odometry.twist.twist.linear.z = 0.0;
+  odometry.twist.twist.angular.x = 0.0;
+  odometry.twist.twist.angular.y = 0.0;
   odometry.twist.twist.angular.z = rates.heading_rate;  // θ̇ = ω1 sin χ / l [rad/s]
   set_diagonal(odometry.twist.covariance, covariance.twist_diagonal);
+}
+
+nav_msgs::Odometry to_odometry(const CartState& state, const CartModel& model, const FrameNames& frames,
+                               const OdometryCovariance& covariance) {
+  nav_msgs::Odometry odometry;
+  fill_odometry(odometry, state, model, frames, covariance);
   return odometry;
 }
 
-geometry_msgs::TransformStamped to_transform(const CartState& state, const CartModel& model,
-                                             const FrameNames& frames) {
+void fill_transform(geometry_msgs::TransformStamped& transform, const CartState& state, const CartModel& model,
+                    const FrameNames& frames) {
   const Eigen::Vector2d rear_axle_midpoint = model.rear_axle_midpoint(state);  // A [m]
-  geometry_msgs::TransformStamped transform;
   transform.header.stamp = to_ros_time(state.time);
   transform.header.frame_id = frames.odom;
   transform.child_frame_id = frames.base_link;
   transform.transform.translation.x = rear_axle_midpoint.x();
   transform.transform.translation.y = rear_axle_midpoint.y();
   transform.transform.translation.z = 0.0;
-  transform.transform.rotation = yaw_quaternion(state.heading);
+  set_yaw_quaternion(transform.transform.rotation, state.heading);
+}
+
+geometry_msgs::TransformStamped to_transform(const CartState& state, const CartModel& model,
+                                             const FrameNames& frames) {
+  geometry_msgs::TransformStamped transform;
+  fill_transform(transform, state, model, frames);
   return transform;
+}
+
+void fill_joint_state(sensor_msgs::JointState& joints, const CartState& state, const CartModel& model,
+                      const ActuatorEfforts& efforts, const std::string& joint_prefix) {
+  const Vector2<double> quasi_velocity(state.forward_speed, state.steering_rate);
+  const CoordinateRates<double> rates = model.coordinate_rates(state.heading, state.steering_angle, quasi_velocity);
+
+  joints.header.stamp = to_ros_time(state.time);
+  const auto& names = joint_names();
+  joints.name.resize(names.size());
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    std::string& name = joints.name[i];  // rebuilt only when it is not already prefix + name
+    if (name.size() != joint_prefix.size() + names[i].size() || name.compare(0, joint_prefix.size(), joint_prefix) != 0 ||
+        name.compare(joint_prefix.size(), std::string::npos, names[i]) != 0) {
+      name = joint_prefix + names[i];
+    }
+  }
+  joints.position.resize(5);
+  joints.velocity.resize(5);
+  joints.effort.resize(5);
+  joints.position[0] = state.steering_angle;
+  joints.velocity[0] = state.steering_rate;
+  for (int wheel = 0; wheel < 4; ++wheel) {
+    joints.position[1 + wheel] = state.wheel_spin_angle[wheel];
+    joints.velocity[1 + wheel] = rates.wheel_spin_rate[wheel];
+  }
+  // The drive torque is the total on the rear axle; each rear wheel carries half of it.
+  joints.effort[0] = efforts.steering_torque;
+  joints.effort[1] = 0.5 * efforts.drive_torque;
+  joints.effort[2] = 0.5 * efforts.drive_torque;
+  joints.effort[3] = 0.0;
+  joints.effort[4] = 0.0;
 }
 
 sensor_msgs::JointState to_joint_state(const CartState& state, const CartModel& model,
                                        const ActuatorEfforts& efforts, const std::string& joint_prefix) {
-  const Vector2<double> quasi_velocity(state.forward_speed, state.steering_rate);
-  const CoordinateRates<double> rates = model.coordinate_rates(state.heading, state.steering_angle, quasi_velocity);
-
   sensor_msgs::JointState joints;
-  joints.header.stamp = to_ros_time(state.time);
-  const auto& names = joint_names();
-  joints.name.reserve(names.size());
-  for (const std::string& name : names) joints.name.push_back(joint_prefix + name);
-  joints.position = {state.steering_angle, state.wheel_spin_angle[0], state.wheel_spin_angle[1],
-                     state.wheel_spin_angle[2], state.wheel_spin_angle[3]};
-  joints.velocity = {state.steering_rate, rates.wheel_spin_rate[0], rates.wheel_spin_rate[1],
-                     rates.wheel_spin_rate[2], rates.wheel_spin_rate[3]};
-  // The drive torque is the total on the rear axle; each rear wheel carries half of it.
-  joints.effort = {efforts.steering_torque, 0.5 * efforts.drive_torque, 0.5 * efforts.drive_torque, 0.0, 0.0};
+  fill_joint_state(joints, state, model, efforts, joint_prefix);
   return joints;
 }
 
@@ -126,10 +158,9 @@ ActuatorEfforts actuator_efforts(const Simulation& simulation) {
   return efforts;
 }
 
-IntegrationError to_integration_error(const CartState& state, const Diagnostics& diagnostics,
-                                      const StepStatistics& statistics, const std::string& integrator,
-                                      double step_size, double wall_time_per_step) {
-  IntegrationError message;
+void fill_integration_error(IntegrationError& message, const CartState& state, const Diagnostics& diagnostics,
+                            const StepStatistics& statistics, const std::string& integrator, double step_size,
+                            double wall_time_per_step) {
   message.header.stamp = to_ros_time(state.time);
   message.integrator = integrator;
   message.step_size = step_size;
@@ -149,6 +180,13 @@ IntegrationError to_integration_error(const CartState& state, const Diagnostics&
   message.local_error_estimate = statistics.local_error_estimate_last_step;  // NaN without an estimate
   message.local_error_estimate_max = statistics.local_error_estimate_max;
   message.local_error_estimate_sum = statistics.local_error_estimate_sum;
+}
+
+IntegrationError to_integration_error(const CartState& state, const Diagnostics& diagnostics,
+                                      const StepStatistics& statistics, const std::string& integrator,
+                                      double step_size, double wall_time_per_step) {
+  IntegrationError message;
+  fill_integration_error(message, state, diagnostics, statistics, integrator, step_size, wall_time_per_step);
   return message;
 }
 

@@ -33,7 +33,7 @@
 #include <std_msgs/Float64.h>
 #include <std_srvs/Empty.h>
 #include <std_srvs/SetBool.h>
-#include <tf2_ros/transform_broadcaster.h>
+#include <rosgraph_msgs/Clock.h>
 
 #include "birkhoff_cart/core/accuracy_guard.h"
 #include "birkhoff_cart/core/simulation.h"
@@ -41,6 +41,7 @@
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
 #include "birkhoff_cart/ros/command_channel.h"
 #include "birkhoff_cart/ros/conversions.h"
+#include "birkhoff_cart/ros/instant_messages.h"
 #include "birkhoff_cart/ros/shutdown_signals.h"
 #include "birkhoff_cart/ros/signaling_callback_queue.h"
 #include "birkhoff_cart/ros/wall_clock_pacing.h"
@@ -144,12 +145,19 @@ class CartSimNode {
   ros::Publisher joint_state_publisher_;
   ros::Publisher integration_error_publisher_;
   ros::Publisher clock_publisher_;
+  ros::Publisher transform_publisher_;  ///< /tf (tf2_msgs/TFMessage), as tf2_ros::TransformBroadcaster advertises it
+  /// The topics as recorded in the bag (resolved names, kept: Publisher::getTopic() returns a copy).
+  std::string odometry_topic_;
+  std::string joint_state_topic_;
+  std::string integration_error_topic_;
+  static constexpr const char* kTransformTopic = "/tf";
+  std::optional<InstantMessages> instant_messages_;  ///< filled in place at each publish instant
+  rosgraph_msgs::Clock clock_message_;
   ros::Subscriber clock_subscriber_;  ///< /clock from elsewhere when ~publish_clock is false
   ros::Subscriber steering_subscriber_;
   ros::Subscriber drive_subscriber_;
   ros::ServiceServer reset_service_;
   ros::ServiceServer pause_service_;
-  std::unique_ptr<tf2_ros::TransformBroadcaster> transform_broadcaster_;
   std::unique_ptr<diagnostic_updater::Updater> diagnostic_updater_;
 
   double run_duration_ = 0.0;             ///< T: the run's length from its start [s]; +inf = without end

@@ -63,14 +63,28 @@ ros::Time to_ros_time(double time);
 nav_msgs::Odometry to_odometry(const CartState& state, const CartModel& model, const FrameNames& frames,
                                const OdometryCovariance& covariance = OdometryCovariance{});
 
+/// to_odometry into an existing message, every field set (its strings keep their capacity: no
+/// allocation once it has held these frame names).
+void fill_odometry(nav_msgs::Odometry& odometry, const CartState& state, const CartModel& model,
+                   const FrameNames& frames, const OdometryCovariance& covariance = OdometryCovariance{});
+
 /// odom → base_link transform of the state (same pose as to_odometry).
 geometry_msgs::TransformStamped to_transform(const CartState& state, const CartModel& model,
                                              const FrameNames& frames);
+
+/// to_transform into an existing message (no allocation once filled).
+void fill_transform(geometry_msgs::TransformStamped& transform, const CartState& state, const CartModel& model,
+                    const FrameNames& frames);
 
 /// Joint positions (χ, φ1..φ4) [rad], velocities (ω2, φ̇1..φ̇4) [rad/s] and actuator efforts
 /// (τ, T/2, T/2, 0, 0) [N·m]. Joint names are `joint_prefix` + joint_names().
 sensor_msgs::JointState to_joint_state(const CartState& state, const CartModel& model,
                                        const ActuatorEfforts& efforts, const std::string& joint_prefix = "");
+
+/// to_joint_state into an existing message: names rebuilt only when they differ, the five values
+/// per vector written in place (no allocation once filled).
+void fill_joint_state(sensor_msgs::JointState& joints, const CartState& state, const CartModel& model,
+                      const ActuatorEfforts& efforts, const std::string& joint_prefix = "");
 
 /// The torques the scene's steering_torque and drive_torque effects apply at the simulation's
 /// current time (the command in force for a command source, the profile otherwise; 0 without the
@@ -81,6 +95,11 @@ ActuatorEfforts actuator_efforts(const Simulation& simulation);
 IntegrationError to_integration_error(const CartState& state, const Diagnostics& diagnostics,
                                       const StepStatistics& statistics, const std::string& integrator,
                                       double step_size, double wall_time_per_step);
+
+/// to_integration_error into an existing message (no allocation once it has held the integrator name).
+void fill_integration_error(IntegrationError& message, const CartState& state, const Diagnostics& diagnostics,
+                            const StepStatistics& statistics, const std::string& integrator, double step_size,
+                            double wall_time_per_step);
 
 }  // namespace ros_conversions
 }  // namespace birkhoff_cart

@@ -1,0 +1,44 @@
+// The messages cart_sim publishes and records at one publish instant, kept as members and filled
+// in place from the simulation: once they have held their strings (frame and joint names, the
+// integrator's name, the accuracy status) a publish instant allocates nothing here
+// (instant_messages_test counts the allocations of steps, fills and bag writes). ROS-free of any
+// master: publishing is the node's (cart_sim_publishing.cpp).
+#pragma once
+
+#include <cstddef>
+#include <limits>
+
+#include <nav_msgs/Odometry.h>
+#include <rosgraph_msgs/Clock.h>
+#include <sensor_msgs/JointState.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include "birkhoff_cart/IntegrationError.h"
+#include "birkhoff_cart/core/accuracy_guard.h"
+#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/ros/conversions.h"
+
+namespace birkhoff_cart {
+
+class InstantMessages {
+ public:
+  InstantMessages(ros_conversions::FrameNames frames, ros_conversions::OdometryCovariance covariance);
+
+  /// Fills odometry, joints, the odom → base_link transform and integration_error from the
+  /// simulation's current state; checks `guard` with its diagnostics (the accuracy fields of
+  /// integration_error follow it). `wall_time_per_step` [s] goes into integration_error.
+  void fill(const Simulation& simulation, AccuracyGuard& guard, double wall_time_per_step);
+
+  nav_msgs::Odometry odometry;
+  sensor_msgs::JointState joints;
+  tf2_msgs::TFMessage transforms;  ///< one transform: odom → base_link
+  IntegrationError integration_error;
+
+ private:
+  ros_conversions::FrameNames frames_;
+  ros_conversions::OdometryCovariance covariance_;
+  /// The guard's event count when its status line was last written (it changes only with them).
+  std::size_t accuracy_events_seen_ = std::numeric_limits<std::size_t>::max();
+};
+
+}  // namespace birkhoff_cart

@@ -1,0 +1,34 @@
+// The messages of one publish instant, filled in place (see instant_messages.h).
+#include "birkhoff_cart/ros/instant_messages.h"
+
+#include <utility>
+
+namespace birkhoff_cart {
+
+InstantMessages::InstantMessages(ros_conversions::FrameNames frames, ros_conversions::OdometryCovariance covariance)
+    : frames_(std::move(frames)), covariance_(covariance) {
+  transforms.transforms.resize(1);
+}
+
+void InstantMessages::fill(const Simulation& simulation, AccuracyGuard& guard, double wall_time_per_step) {
+  const CartState& state = simulation.state();
+  const CartModel& model = simulation.model();
+  ros_conversions::fill_odometry(odometry, state, model, frames_, covariance_);
+  ros_conversions::fill_joint_state(joints, state, model, ros_conversions::actuator_efforts(simulation),
+                                    frames_.joint_prefix);
+  ros_conversions::fill_transform(transforms.transforms.front(), state, model, frames_);
+  const Diagnostics diagnostics = simulation.diagnostics();
+  guard.check(state.time, diagnostics, simulation.statistics());
+  ros_conversions::fill_integration_error(integration_error, state, diagnostics, simulation.statistics(),
+                                          simulation.integrator_name(), simulation.step_size(), wall_time_per_step);
+  integration_error.accuracy_level = static_cast<std::uint8_t>(guard.level());
+  integration_error.accuracy_current_level = static_cast<std::uint8_t>(guard.current_level());
+  // The worst-level line depends only on the guard's events: rebuilt (a new string) only when one
+  // has been added.
+  if (guard.events().size() != accuracy_events_seen_) {
+    integration_error.accuracy_status = guard.summary();
+    accuracy_events_seen_ = guard.events().size();
+  }
+}
+
+}  // namespace birkhoff_cart
