@@ -19,18 +19,34 @@ namespace odeint = boost::numeric::odeint;
 /// The joint state (z, y) of the autonomous Birkhoffian form, as odeint sees it.
 using Joint = std::array<double, kBirkhoffianSize + kPassiveSize>;
 
-/// (ż, ẏ) = (K⁻¹(∇B + ∂R/∂t + Λ), g(z, y, t)) for odeint.
+/// (ż, ẏ) for odeint: ż = K₀⁻¹(∇H̃ + Λ) = (ω, ṗ) with ṗ = ∂T*/∂q|_ω + Λ_nh + Q (CartModel::momentum_rate,
+/// eq. (3.6)) and ẏ = g(z, y, t) (CartBirkhoffianBase::passive_rates), from ONE evaluation of
+/// ω = M(χ)⁻¹ p and of the loads Q. birkhoffian_rates() and passive_coordinate_rates() would each
+/// evaluate both again (the loads were a third of the shadow's cost); the rates are the same up to
+/// round-off.
 struct JointRates {
   const CartAutonomousBirkhoffian* system;
+  const CartModel* model;
   void operator()(const Joint& state, Joint& rate, double time) const {
     StateVector<CartAutonomousBirkhoffian, double> z;
-    PassiveVector<CartAutonomousBirkhoffian, double> y;
     for (int i = 0; i < kBirkhoffianSize; ++i) z(i) = state[i];
-    for (int i = 0; i < kPassiveSize; ++i) y(i) = state[kBirkhoffianSize + i];
-    const auto z_rate = birkhoffian_rates(*system, z, time);                // ż = f(z, t)
-    const auto y_rate = passive_coordinate_rates(*system, z, y, time);      // ẏ = g(z, y, t)
-    for (int i = 0; i < kBirkhoffianSize; ++i) rate[i] = z_rate(i);
-    for (int i = 0; i < kPassiveSize; ++i) rate[kBirkhoffianSize + i] = y_rate(i);
+    const double chi = z(kSteeringAngleIndex);
+    const Vector2<double> omega = system->quasi_velocity(z);                 // ω = M(χ)⁻¹ p
+    const Vector2<double> force = system->generalized_force(chi, omega, time);  // Q
+    const Vector2<double> momentum_rate = model->momentum_rate(chi, omega, force);
+    rate[kArcLengthIndex] = omega(0);
+    rate[kSteeringAngleIndex] = omega(1);
+    rate[kForwardMomentumIndex] = momentum_rate(0);
+    rate[kSteeringMomentumIndex] = momentum_rate(1);
+    const CoordinateRates<double> rates =
+        model->coordinate_rates(state[kBirkhoffianSize + kHeadingIndex], chi, omega);
+    double* passive = rate.data() + kBirkhoffianSize;
+    passive[kXIndex] = rates.x_rate;
+    passive[kYIndex] = rates.y_rate;
+    passive[kHeadingIndex] = rates.heading_rate;
+    for (int wheel = 0; wheel < 4; ++wheel) passive[kWheel1Index + wheel] = rates.wheel_spin_rate[wheel];
+    passive[kAppliedWorkIndex] = omega.dot(force);
+    passive[kSteeringImpulseIndex] = force(1);
   }
 };
 
@@ -39,7 +55,7 @@ class DenseShadowReference : public ReferenceSolution {
  public:
   DenseShadowReference(const IntegratorSettings& settings, const CartState& initial, const CartModel& model,
                        const EffectSet& effects)
-      : settings_(settings), initial_(initial), system_(model, effects),
+      : settings_(settings), initial_(initial), model_(&model), system_(model, effects),
         stepper_(odeint::make_dense_output(settings.tolerance, settings.tolerance,
                                            odeint::runge_kutta_dopri5<Joint>())) {
     restart(initial_, settings_.step_size);
@@ -58,7 +74,7 @@ class DenseShadowReference : public ReferenceSolution {
         throw StepError(message.str());
       }
       try {
-        stepper_.do_step(JointRates{&system_});  // one accepted step (odeint retries rejected ones)
+        stepper_.do_step(JointRates{&system_, model_});  // one accepted step (odeint retries rejected ones)
       } catch (const odeint::odeint_error& error) {  // Boost ≥ 1.60: step_adjustment_error et al.
         throw StepError("shadow reference (dopri5) failed at t = " + std::to_string(stepper_.current_time()) +
                         " s: " + error.what());
@@ -115,6 +131,7 @@ class DenseShadowReference : public ReferenceSolution {
 
   IntegratorSettings settings_;
   CartState initial_;
+  const CartModel* model_;
   CartAutonomousBirkhoffian system_;
   // calc_state() is const in meaning but not in odeint's signature.
   mutable odeint::result_of::make_dense_output<odeint::runge_kutta_dopri5<Joint>>::type stepper_;
