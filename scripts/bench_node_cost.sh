@@ -4,7 +4,9 @@
 # 100 Hz publishing, its dopri5 shadow reference on) in fast mode for 300 s of scene time, with and
 # without the bag, beside cart_simulate on the same scene and duration (the bare core with CSV at
 # 100 Hz), three times each; then lockstep with steering_pd_controller (driven.yaml, 60 s at 50 Hz)
-# and real-time mode at 1 kHz (CPU share of one core over 15 s of wall time).
+# and real-time mode at 1 kHz (CPU share of one core over 15 s of wall time). Also the default
+# scene as shipped (birkhoff_gauss4 at h = 10 ms) with and without the bag beside cart_simulate,
+# and the bag uncompressed (~bag_compression none) once.
 # Ratios: scene time / wall time (the node's from its own summary: its time loop), and CPU time
 # (user + sys of the whole process, all threads) — the machine is shared, so CPU time is the
 # steadier measure of cost; node/core = node's cost over cart_simulate's.
@@ -44,45 +46,58 @@ fi
 rosparam set /use_sim_time true
 
 cpu_ticks() { awk '{print $14 + $15}' "/proc/$1/stat"; }  # utime + stime [clock ticks]
+# CPU time of every thread of process $1 [ns] (schedstat's first field: time on a CPU), exact where
+# clock ticks are 10 ms coarse.
+cpu_nanoseconds() { cat /proc/"$1"/task/*/schedstat 2>/dev/null | awk '{s += $1} END {printf "%.0f", s}'; }
 
 timed() {  # $1 output file for "wall user sys"; the rest: the command
   local out="$1"; shift
   /usr/bin/time -f "%e %U %S" -o "$out" "$@"
 }
 
+stepping="_integrator:=birkhoff2 _step_size:=0.001"      # the issue's stepping (node)
+core_stepping="--integrator birkhoff2 --step 0.001"      # the same for cart_simulate
 node_fast() {  # $1 label, $2 extra parameters -> "node_wall node_loop_rtf node_cpu"
   rosparam delete /cart_sim > /dev/null 2>&1 || true
   # shellcheck disable=SC2086
-  timed "$work/$1.time" "$bin/cart_sim" __name:=cart_sim _scene:="$scene" _integrator:=birkhoff2 _step_size:=0.001 _fast:=true \
+  timed "$work/$1.time" "$bin/cart_sim" __name:=cart_sim _scene:="$scene" $stepping _fast:=true \
     _publish_rate:=100 _duration:=$duration _summary_path:="$work/$1.summary" $2 > "$work/$1.log" 2>&1
   local rtf; rtf=$(grep -o 'real-time factor [0-9.e+]*' "$work/$1.summary" | awk '{print $3}')
   awk -v rtf="$rtf" '{printf "%s %s %s", $1, rtf, $2 + $3}' "$work/$1.time"
 }
 
 core_run() {  # -> "wall cpu"
-  timed "$work/core.time" "$bin/cart_simulate" --scene "$scene" --integrator birkhoff2 --step 0.001 --output-rate 100 \
+  # shellcheck disable=SC2086
+  timed "$work/core.time" "$bin/cart_simulate" --quiet --scene "$scene" $core_stepping --output-rate 100 \
     --duration $duration --output "$work/core.csv" > /dev/null
   awk '{printf "%s %s", $1, $2 + $3}' "$work/core.time"
 }
 
+fast_table() {  # $1 title; three runs of node with bag, without, and cart_simulate
+  echo "$1"
+  printf "%-4s | %-34s | %-34s | %-22s | %s\n" run "node, bag: wall s (loop x) / CPU s" "node, no bag: wall s (loop x) / CPU s" \
+    "cart_simulate: wall / CPU s" "x real time (scene/wall): node bag, core; node/core wall, CPU"
+  for repetition in 1 2 3; do
+    read -r bag_wall bag_rtf bag_cpu <<< "$(node_fast "bag_$repetition" "_bag_path:=$work/node.bag")"
+    read -r nobag_wall nobag_rtf nobag_cpu <<< "$(node_fast "nobag_$repetition" "")"
+    read -r core_wall core_cpu <<< "$(core_run)"
+    awk -v r="$repetition" -v bw="$bag_wall" -v br="$bag_rtf" -v bc="$bag_cpu" -v nw="$nobag_wall" -v nr="$nobag_rtf" \
+      -v nc="$nobag_cpu" -v cw="$core_wall" -v cc="$core_cpu" -v T="$duration" \
+      'BEGIN {printf "%-4s | %6.2f (%5.0fx) / %5.2f               | %6.2f (%5.0fx) / %5.2f                 | %6.2f / %5.2f          | node %5.0fx, core %5.0fx; %4.2f, %4.2f\n",
+              r, bw, br, bc, nw, nr, nc, cw, cc, T / bw, T / cw, bw / cw, bc / cc}'
+    awk -v T="$duration" -v bc="$bag_cpu" -v nc="$nobag_cpu" -v cc="$core_cpu" \
+      'BEGIN {printf "       per CPU second: node with bag %5.0fx, node without bag %5.0fx, cart_simulate %5.0fx\n", T / bc, T / nc, T / cc}'
+  done
+  echo "  bag: $(ls -l "$work/node.bag" | awk '{print $5}') bytes; $(rosbag info "$work/node.bag" | grep -E '^(messages|compression)' | tr -s ' ' | tr '\n' ';')"
+}
+
 echo "load before: $(cat /proc/loadavg)"
-printf "%-4s | %-34s | %-34s | %-22s | %s\n" run "node, bag: wall s (loop x) / CPU s" "node, no bag: wall s (loop x) / CPU s" \
-  "cart_simulate: wall / CPU s" "x real time (scene/wall): node bag, core; node/core wall, CPU"
-for repetition in 1 2 3; do
-  read -r bag_wall bag_rtf bag_cpu <<< "$(node_fast "bag_$repetition" "_bag_path:=$work/node.bag")"
-  read -r nobag_wall nobag_rtf nobag_cpu <<< "$(node_fast "nobag_$repetition" "")"
-  read -r core_wall core_cpu <<< "$(core_run)"
-  awk -v r="$repetition" -v bw="$bag_wall" -v br="$bag_rtf" -v bc="$bag_cpu" -v nw="$nobag_wall" -v nr="$nobag_rtf" \
-    -v nc="$nobag_cpu" -v cw="$core_wall" -v cc="$core_cpu" -v T="$duration" \
-    'BEGIN {printf "%-4s | %6.2f (%5.0fx) / %5.2f               | %6.2f (%5.0fx) / %5.2f                 | %6.2f / %5.2f          | node %5.0fx, core %5.0fx; %4.2f, %4.2f\n",
-            r, bw, br, bc, nw, nr, nc, cw, cc, T / bw, T / cw, bw / cw, bc / cc}'
-done
-echo "bag: $(ls -l "$work/node.bag" | awk '{print $5}') bytes; $(rosbag info "$work/node.bag" | grep -E '^messages')"
-echo "CPU-time ratios: scene time / CPU time of the process (the machine's load does not enter)"
-for repetition in 1 2 3; do
-  awk -v T="$duration" '{printf "  run: node with bag %5.0fx of its CPU time\n", T / ($2 + $3)}' "$work/bag_$repetition.time"
-done
-awk -v T="$duration" '{printf "  cart_simulate (last run) %5.0fx of its CPU time\n", T / ($2 + $3)}' "$work/core.time"
+fast_table "default scene, birkhoff2 at h = 1 ms (the issue's stepping), 100 Hz, $duration s:"
+read -r none_wall none_rtf none_cpu <<< "$(node_fast "bag_none" "_bag_path:=$work/node_none.bag _bag_compression:=none")"
+echo "  bag uncompressed (~bag_compression none): wall $none_wall s (loop ${none_rtf}x) / CPU $none_cpu s; $(ls -l "$work/node_none.bag" | awk '{print $5}') bytes"
+stepping=""; core_stepping=""
+fast_table "default scene as shipped (its own integrator and step: birkhoff_gauss4 at h = 10 ms), 100 Hz, $duration s:"
+echo "load: $(cat /proc/loadavg)"
 
 # Lockstep with the example controller: 60 s of driven.yaml at 50 Hz control.
 rosparam delete /cart_sim > /dev/null 2>&1 || true
@@ -100,12 +115,16 @@ rosparam delete /cart_sim > /dev/null 2>&1 || true
   > "$work/real_time.log" 2>&1 &
 node_pid=$!
 sleep 3
-ticks0=$(cpu_ticks "$node_pid"); wall0=$(date +%s.%N)
+ticks0=$(cpu_ticks "$node_pid"); ns0=$(cpu_nanoseconds "$node_pid"); wall0=$(date +%s.%N)
+switches0=$(awk '/^voluntary_ctxt_switches/ {print $2}' "/proc/$node_pid/status")
 sleep 15
-ticks1=$(cpu_ticks "$node_pid"); wall1=$(date +%s.%N)
+ticks1=$(cpu_ticks "$node_pid"); ns1=$(cpu_nanoseconds "$node_pid"); wall1=$(date +%s.%N)
+switches1=$(awk '/^voluntary_ctxt_switches/ {print $2}' "/proc/$node_pid/status")
 wait "$node_pid" || true
 awk -v t0="$ticks0" -v t1="$ticks1" -v w0="$wall0" -v w1="$wall1" -v hz="$clock_ticks" \
-  'BEGIN {printf "real-time mode, default scene, h = 1 ms, 100 Hz publishing: CPU %.2f s over %.2f s wall = %.2f%% of one core\n", (t1 - t0) / hz, w1 - w0, 100 * (t1 - t0) / hz / (w1 - w0)}'
+  'BEGIN {printf "real-time mode, default scene, h = 1 ms, 100 Hz publishing: CPU %.2f s over %.2f s wall = %.2f%% of one core (clock ticks)\n", (t1 - t0) / hz, w1 - w0, 100 * (t1 - t0) / hz / (w1 - w0)}'
+awk -v n0="$ns0" -v n1="$ns1" -v w0="$wall0" -v w1="$wall1" -v s0="$switches0" -v s1="$switches1" \
+  'BEGIN {printf "  the same window by schedstat (all threads, ns): CPU %.4f s = %.2f%% of one core; main thread %.0f wake-ups per second\n", (n1 - n0) / 1e9, 100 * (n1 - n0) / 1e9 / (w1 - w0), (s1 - s0) / (w1 - w0)}'
 # Command latency in real-time mode: a responder answers every /clock (published at each 100 Hz
 # publish instant t_k) with a steering_torque at once; the node records each command at the scene
 # time of the step it takes effect after, t_c. t_c - t_k (scene time = wall time at factor 1) is
