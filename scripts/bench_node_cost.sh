@@ -62,7 +62,7 @@ node_fast() {  # $1 label, $2 extra parameters -> "node_wall node_loop_rtf node_
   # shellcheck disable=SC2086
   timed "$work/$1.time" "$bin/cart_sim" __name:=cart_sim _scene:="$scene" $stepping _fast:=true \
     _publish_rate:=100 _duration:=$duration _summary_path:="$work/$1.summary" $2 > "$work/$1.log" 2>&1
-  local rtf; rtf=$(grep -o 'real-time factor [0-9.e+]*' "$work/$1.summary" | awk '{print $3}')
+  local rtf; rtf=$(grep -o 'real-time factor [0-9.e+]*' "$work/$1.summary" | awk '{print $3}'); rtf="${rtf%.}"
   awk -v rtf="$rtf" '{printf "%s %s %s", $1, rtf, $2 + $3}' "$work/$1.time"
 }
 
