@@ -142,8 +142,8 @@ class BagRecorder {
   void write_queued();
   /// Throws BagRecorderError for a failed writer or a closed bag (mutex_ held).
   void throw_if_unusable() const;
-  /// " (N bytes free in DIR)" after a failed write: rosbag's own messages ("Error seeking",
-  /// "Problem writing data to disk") do not say that the disk is full. "" when statvfs fails.
+  /// " (N bytes free in DIR)" after a failed write, so the message says how full the disk is.
+  /// "" when statvfs fails.
   std::string free_space_note() const;
 
   std::string path_;
