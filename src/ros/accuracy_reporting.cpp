@@ -59,12 +59,6 @@ AccuracyRequirements load_requirements(const ros::NodeHandle& private_node,
   return requirements;
 }
 
-void fill(IntegrationError& message, const AccuracyGuard& guard) {
-  message.accuracy_level = static_cast<std::uint8_t>(guard.level());
-  message.accuracy_current_level = static_cast<std::uint8_t>(guard.current_level());
-  message.accuracy_status = guard.summary();
-}
-
 void report(diagnostic_updater::DiagnosticStatusWrapper& status, const AccuracyGuard& guard,
             const StepStatistics& statistics, const std::string& integrator) {
   if (guard.level() != AccuracyLevel::kOk) {

@@ -1,6 +1,6 @@
 // The accuracy guard in cart_sim (docs/accuracy.md §2): its limits from the scene's `accuracy`
 // section overridden by the private parameters ~accuracy/<quantity>, and how its verdict and the
-// local error estimate reach ~integration_error, /diagnostics and the summary. Translation only:
+// local error estimate reach /diagnostics and the summary (~integration_error: InstantMessages). Translation only:
 // AccuracyGuard (core) decides.
 #pragma once
 
@@ -9,7 +9,6 @@
 #include <diagnostic_updater/DiagnosticStatusWrapper.h>
 #include <ros/node_handle.h>
 
-#include "birkhoff_cart/IntegrationError.h"
 #include "birkhoff_cart/core/accuracy_guard.h"
 #include "birkhoff_cart/core/diagnostics.h"
 
@@ -19,9 +18,6 @@ namespace ros_accuracy {
 /// `scene_requirements` with each ~accuracy/<quantity> parameter applied: the string "off", or a
 /// map {warn: W, error: E} (0 < W ≤ E, finite). Throws std::invalid_argument naming the parameter.
 AccuracyRequirements load_requirements(const ros::NodeHandle& private_node, const AccuracyRequirements& scene_requirements);
-
-/// Fills the guard's fields of an integration_error message (levels and status line).
-void fill(IntegrationError& message, const AccuracyGuard& guard);
 
 /// Raises `status` to the guard's worst level (WARN/ERROR) with its line appended to the message,
 /// and adds the guard's and the estimate's key-values.
