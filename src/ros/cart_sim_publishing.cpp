@@ -15,9 +15,10 @@ void CartSimNode::publish_clock(double time) {
 }
 
 void CartSimNode::publish_instant() {
-  // The messages are members filled in place (InstantMessages): nothing is allocated here once
-  // they hold their strings. roscpp serializes into a buffer of its own per message only for a
-  // topic that has subscribers.
+  // The messages are members filled in place (InstantMessages): the node allocates nothing here
+  // once they hold their strings. roscpp 1.15's typed publish() still builds a std::string of the
+  // md5sum at every call (ros/publisher.h), and serializes into a buffer of its own for a topic
+  // with subscribers.
   last_wall_time_per_step_ = period_steps_ > 0 ? period_stepping_wall_time_ / static_cast<double>(period_steps_) : 0.0;
   period_stepping_wall_time_ = 0.0;
   period_steps_ = 0;

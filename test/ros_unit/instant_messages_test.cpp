@@ -4,8 +4,8 @@
 // (BagRecorder::write) — is run with a replaced global operator new that counts the allocations
 // of this thread. After a warm-up (the messages hold their strings; every ring slot has held its
 // message type once) the count over many instants must be zero. The bag's writer thread (chunk
-// bookkeeping) and roscpp's publish (a serialization buffer per message for a topic with
-// subscribers) are outside this path and not counted. Also: filled messages equal the to_*
+// bookkeeping) and roscpp's publish (its typed publish() builds a std::string of the md5sum at
+// every call, and serializes for a topic with subscribers) are outside this path and not counted. Also: filled messages equal the to_*
 // conversions. No master needed.
 #include <gtest/gtest.h>
 
