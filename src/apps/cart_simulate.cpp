@@ -57,14 +57,17 @@ constexpr double kProgressPeriod = 1.0;  // at most one progress line per this m
 const char* const kUsage =
     "usage: cart_simulate --scene FILE [--integrator NAME] [--step H] [--tolerance TOL]\n"
     "                     [--duration T] [--output-rate HZ] [--birkhoffian-form F] [--quiet]\n"
-    "                     [--on-accuracy-error fail|warn] --output FILE.csv\n"
+    "                     [--step-control fixed|reversible] [--on-accuracy-error fail|warn] --output FILE.csv\n"
     "       cart_simulate --help | -h | --version\n"
     "  --scene FILE            scene YAML (config/scenes/*.yaml); it provides every default\n"
     "  --integrator NAME       birkhoff2, birkhoff4, birkhoff_gauss4, birkhoff_gauss6, birkhoff_gauss8,\n"
     "                          birkhoff4_suzuki, birkhoff6_kahan_li, birkhoff8_kahan_li, rk2, rk4, dopri5\n"
     "                          or midpoint (docs/birkhoffian.md; README, \"The integrators\")\n"
     "  --step H                step size [s], > 0; 1/HZ must be a whole multiple of it\n"
-    "  --tolerance TOL         dopri5 absolute and relative tolerance [-], >= 10 machine epsilon (2.2e-15)\n"
+    "  --tolerance TOL         dopri5: absolute and relative tolerance [-], >= 10 machine epsilon (2.2e-15);\n"
+    "                          reversible step control: the position error [m] allowed at the horizon\n"
+    "  --step-control C        fixed (steps of H) or reversible (symmetric Birkhoffian members: their own\n"
+    "                          steps for --tolerance, H is then the output step; docs/accuracy.md §4)\n"
     "  --duration T            simulated time after the start [s], > 0\n"
     "  --output-rate HZ        output rows per simulated second [Hz], > 0\n"
     "  --birkhoffian-form F    autonomous or paper\n"
@@ -109,7 +112,7 @@ bool asks_for_help(int argc, char** argv) {
 std::map<std::string, std::string> parse_arguments(int argc, char** argv) {
   static const char* const kOptions[] = {"--scene",       "--integrator",       "--step",  "--tolerance",
                                          "--duration",    "--output-rate",      "--birkhoffian-form", "--output",
-                                         "--on-accuracy-error"};
+                                         "--on-accuracy-error", "--step-control"};
   std::map<std::string, std::string> values;
   for (int i = 1; i < argc; ++i) {
     const std::string option = argv[i];
@@ -143,6 +146,12 @@ void apply_overrides(const std::map<std::string, std::string>& arguments, Scene&
         throw UsageError("option --birkhoffian-form must be 'autonomous' or 'paper', got '" + text + "'");
       }
       scene.integrator.birkhoffian_form = text;
+    }
+    if (option == "--step-control") {
+      if (text != "fixed" && text != "reversible") {
+        throw UsageError("option --step-control must be 'fixed' or 'reversible', got '" + text + "'");
+      }
+      scene.integrator.step_control = text;
     }
     if (option == "--on-accuracy-error" && text != "fail" && text != "warn") {
       throw UsageError("option --on-accuracy-error must be 'fail' or 'warn', got '" + text + "'");

@@ -100,7 +100,8 @@ CartState read_initial_state(const SceneReader& reader, const YAML::Node& node) 
 IntegratorSettings read_integrator(const SceneReader& reader, const YAML::Node& node, const std::string& key) {
   reader.require_map(node, key,
                      {"name", "step_size", "tolerance", "birkhoffian_form", "max_newton_iterations",
-                      "newton_tolerance", "compensated_summation", "local_error_estimate"});
+                      "newton_tolerance", "compensated_summation", "local_error_estimate", "step_control", "max_step",
+                      "tolerance_horizon"});
   IntegratorSettings settings;
   settings.name = reader.choice(node, key, "name", known_integrators());
   settings.step_size = reader.required_number(node, key, "step_size", Range::kPositive);
@@ -116,6 +117,24 @@ IntegratorSettings read_integrator(const SceneReader& reader, const YAML::Node& 
       reader.optional_boolean(node, key, "compensated_summation", settings.compensated_summation);
   settings.local_error_estimate =
       reader.optional_boolean(node, key, "local_error_estimate", settings.local_error_estimate);
+  if (reader.has(node, "step_control")) {
+    settings.step_control = reader.choice(node, key, "step_control", {"fixed", "reversible"});
+  }
+  settings.max_step = reader.optional_number(node, key, "max_step", Range::kPositive, settings.max_step);
+  settings.tolerance_horizon =
+      reader.optional_number(node, key, "tolerance_horizon", Range::kPositive, settings.tolerance_horizon);
+  if (settings.step_control == "reversible") {
+    const std::vector<std::string> members = reversible_integrator_names();
+    if (std::find(members.begin(), members.end(), settings.name) == members.end()) {
+      std::string list;
+      for (const std::string& member : members) list += (list.empty() ? "" : ", ") + member;
+      reader.fail(key + ".step_control", "'reversible' is for the symmetric Birkhoffian members (" + list + "), not '" +
+                                             settings.name + "'");
+    }
+  } else if (reader.has(node, "max_step") || reader.has(node, "tolerance_horizon")) {
+    reader.fail(key + (reader.has(node, "max_step") ? ".max_step" : ".tolerance_horizon"),
+                "is only for 'step_control: reversible'");
+  }
   return settings;
 }
 
@@ -127,6 +146,9 @@ ReferenceSettings read_reference(const SceneReader& reader, const YAML::Node& no
   if (kind == "shadow_run") {
     reference.kind = ReferenceSettings::Kind::kShadowRun;
     reference.shadow = read_integrator(reader, reader.required(node, "reference", "integrator"), "reference.integrator");
+    if (reference.shadow.step_control != "fixed") {
+      reader.fail("reference.integrator.step_control", "must be 'fixed' (the shadow run is a dense dopri5 or a fixed step)");
+    }
   } else {
     if (reader.has(node, "integrator")) reader.fail("reference.integrator", "is only for kind 'shadow_run'");
     if (kind == "paper_analytic") {

@@ -31,13 +31,21 @@ void require_finite_torque(double torque, const char* which) {
   }
 }
 
+/// The scene's integrator settings with the defaults that depend on the scene filled in: the
+/// reversible controller's tolerance horizon is the scene's duration unless the scene names one.
+IntegratorSettings integrator_settings(const Scene& scene) {
+  IntegratorSettings settings = scene.integrator;
+  if (settings.tolerance_horizon == 0.0) settings.tolerance_horizon = scene.duration;
+  return settings;
+}
+
 }  // namespace
 
 Simulation::Simulation(const Scene& scene)
     : scene_(scene),
       model_(scene.cart, inertia_model_of(scene)),
       effects_(build_effects(scene.effects, model_)),
-      stepper_(make_cart_stepper(scene.integrator, model_, effects_)),
+      stepper_(make_cart_stepper(integrator_settings(scene), model_, effects_)),
       state_(scene.initial_state),
       schedule_(plan_steps(scene.initial_state.time, scene.duration, scene.integrator.step_size)) {
   initial_energy_ = model_.energy(state_);
@@ -101,7 +109,7 @@ void Simulation::advance_to(double time) {
 }
 
 void Simulation::reset() {
-  stepper_ = make_cart_stepper(scene_.integrator, model_, effects_);  // forgets adaptive step-size guesses
+  stepper_ = make_cart_stepper(integrator_settings(scene_), model_, effects_);  // forgets adaptive step-size guesses
   state_ = scene_.initial_state;
   steps_taken_ = 0;
   finished_off_grid_ = false;

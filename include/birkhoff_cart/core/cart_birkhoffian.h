@@ -82,6 +82,45 @@ class CartBirkhoffianBase {
     return effects_->generalized_force(value_of(t), steering_angle, omega);
   }
 
+  /// ω̇ = M⁻¹ (ṗ − (dM/dχ) ω2 ω) [m/s², rad/s²] at (z, t): the quasi-accelerations (eq. (3.6) with
+  /// ṗ from momentum_rate; dM/dχ = [[2 μ1 s c, ν c], [ν c, 0]] from eq. (3.3)).
+  template <class S>
+  Vector2<S> quasi_acceleration(const Vector<S>& z, const S& t) const {
+    using std::cos;
+    using std::sin;
+    const S& chi = z(kSteeringAngleIndex);
+    const Vector2<S> omega = quasi_velocity(z);
+    const Vector2<S> p_rate = momentum_rate(chi, omega, t);
+    const S s = sin(chi);
+    const S c = cos(chi);
+    const ReducedInertia& inertia = model_->inertia();
+    const S m00 = S(2.0 * inertia.mu1) * s * c;
+    const S m01 = S(inertia.nu) * c;
+    const Vector2<S> mass_rate_omega(omega(1) * (m00 * omega(0) + m01 * omega(1)), omega(1) * m01 * omega(0));
+    return model_->quasi_velocity(chi, Vector2<S>(p_rate - mass_rate_omega));
+  }
+
+  /// The squared step density of the reversible step control (reversible_step_control.h,
+  /// docs/birkhoffian.md §11, eq. (B.39)) [1/s²]:
+  ///   σ² = ω2² + θ̇² + √((ω̇1/l)² + ω̇2² + σ₀⁴),   θ̇ = ω1 sin χ / l (eq. (2.3)),
+  /// how fast the front axle turns against the body and the body against the ground, and how fast
+  /// those rates change (a hinge spring's swing, a torque's push). On the jackknife whirl χ turns at
+  /// up to 5 rad/s near the jackknife and at 0.8 rad/s elsewhere: the steps shrink there. σ₀
+  /// [1/s] is the slowest rate the steps resolve where the cart neither turns nor accelerates.
+  template <class S>
+  S squared_step_density(const Vector<S>& z, const S& t, double density_floor) const {
+    using std::sin;
+    using std::sqrt;
+    const double l = model_->parameters().wheelbase;
+    const Vector2<S> omega = quasi_velocity(z);
+    const Vector2<S> acceleration = quasi_acceleration(z, t);
+    const S heading_rate = omega(0) * sin(z(kSteeringAngleIndex)) / l;
+    const S forward = acceleration(0) / l;
+    const double floor4 = density_floor * density_floor * density_floor * density_floor;
+    return omega(1) * omega(1) + heading_rate * heading_rate +
+           sqrt(forward * forward + acceleration(1) * acceleration(1) + S(floor4));
+  }
+
   /// H̃ = ½ pᵀ M(χ)⁻¹ p = T* [J].
   template <class S>
   S hamiltonian(const Vector<S>& z) const {

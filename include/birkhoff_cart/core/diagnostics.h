@@ -14,6 +14,10 @@ struct StepStatistics {
   std::uint64_t passive_evaluations = 0;      ///< separate evaluations of the passive rates g (collocation members)
   std::uint64_t newton_iterations_total = 0;  ///< implicit-solve iterations (Newton or fixed point); 0 for explicit methods
   std::uint64_t newton_iterations_last_step = 0;
+  // A step-size controller's own steps inside the caller's steps (reversible_step_control.h).
+  std::uint64_t internal_steps = 0;                                          ///< grid steps taken
+  double internal_step_min = std::numeric_limits<double>::infinity();        ///< smallest |h| [s]
+  double internal_step_max = 0.0;                                            ///< largest |h| [s]
 
   // The local error estimate (docs/accuracy.md): per step, the weighted max-norm
   //   ê = maxᵢ |x̂ᵢ − xᵢ| / max(1, |xᵢ(tₖ)|)

@@ -5,6 +5,7 @@
 
 #include <map>
 #include <stdexcept>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -70,6 +71,12 @@ struct IntegratorSettings {
   double newton_tolerance = 1e-14;                ///< on the scaled Newton update [-]
   bool compensated_summation = true;              ///< Birkhoffian members: Kahan/TwoSum state update
   bool local_error_estimate = true;               ///< Birkhoffian members: compute ê (one more rhs evaluation a step)
+  /// "fixed": steps of step_size. "reversible" (symmetric Birkhoffian members): internal steps
+  /// chosen by the reversible controller (docs/birkhoffian.md §11) for `tolerance` as the position
+  /// error [m] the run may reach by `tolerance_horizon`; step_size is then only the output step.
+  std::string step_control = "fixed";
+  double max_step = std::numeric_limits<double>::infinity();  ///< reversible: the longest internal step [s]
+  double tolerance_horizon = 0.0;   ///< reversible: the time the tolerance is for [s]; 0: the scene's duration
 };
 
 /// What the simulation compares itself against, computed only when asked for.

@@ -15,59 +15,13 @@
 #include "birkhoff_cart/core/integrators/dopri5.h"
 #include "birkhoff_cart/core/integrators/implicit_midpoint.h"
 #include "birkhoff_cart/core/integrators/runge_kutta.h"
+#include "reversible_cart_stepper.h"
+#include "step_checks.h"
 
 namespace birkhoff_cart {
 namespace {
 
-const char* const kBirkhoffianNames[kBirkhoffianSize] = {"arc_length pi1", "steering_angle chi",
-                                                        "forward momentum p1", "steering momentum p2"};
-const char* const kPassiveNames[kPassiveSize] = {"x",
-                                                 "y",
-                                                 "heading theta",
-                                                 "wheel_spin_angle phi1",
-                                                 "wheel_spin_angle phi2",
-                                                 "wheel_spin_angle phi3",
-                                                 "wheel_spin_angle phi4",
-                                                 "applied_work W",
-                                                 "steering_impulse I2"};
-
-void require_valid_step_size(double step_size) {
-  if (!(step_size > 0.0) || !std::isfinite(step_size)) {
-    std::ostringstream message;
-    message << "step size must be finite and > 0 s, got " << step_size;
-    throw std::invalid_argument(message.str());
-  }
-}
-
-[[noreturn]] void throw_non_finite(const std::string& integrator, double time, double step_size,
-                                   const std::string& quantity, double value) {
-  std::ostringstream message;
-  message.precision(17);
-  message << integrator << " step from t = " << time << " s (h = " << step_size << " s) produced a non-finite "
-          << quantity << " (" << value << ")";
-  throw StepError(message.str());
-}
-
-/// Throws StepError naming the first non-finite coordinate of (z, y) or quasi-velocity of `next`:
-/// what every adapter checks before it hands a step's result out.
-void require_finite_result(const std::string& integrator, double time, double step_size,
-                           const Eigen::Matrix<double, kBirkhoffianSize, 1>& z,
-                           const Eigen::Matrix<double, kPassiveSize, 1>& y) {
-  for (int i = 0; i < kBirkhoffianSize; ++i) {
-    if (!std::isfinite(z(i))) throw_non_finite(integrator, time, step_size, kBirkhoffianNames[i], z(i));
-  }
-  for (int i = 0; i < kPassiveSize; ++i) {
-    if (!std::isfinite(y(i))) throw_non_finite(integrator, time, step_size, kPassiveNames[i], y(i));
-  }
-}
-void require_finite_speeds(const std::string& integrator, double time, double step_size, const CartState& next) {
-  if (!std::isfinite(next.forward_speed)) {
-    throw_non_finite(integrator, time, step_size, "forward_speed omega1 (singular mass matrix?)", next.forward_speed);
-  }
-  if (!std::isfinite(next.steering_rate)) {
-    throw_non_finite(integrator, time, step_size, "steering_rate omega2 (singular mass matrix?)", next.steering_rate);
-  }
-}
+using namespace stepper_checks;
 
 /// The command torques (steering, drive) [N·m] the effects read now; 0 for a source that is absent.
 std::array<double, 2> command_torques(const EffectSet& effects) {
@@ -169,6 +123,12 @@ class CarriedCartStepperAdapter final : public CartStepper {
   CarriedCartState<System, typename Stepper::template Memory<System>> carried_;
 };
 
+std::string reversible_names() {
+  std::string list;
+  for (const std::string& name : reversible_integrator_names()) list += (list.empty() ? "" : ", ") + name;
+  return list;
+}
+
 template <class Stepper, class System>
 std::unique_ptr<CartStepper> make_adapter(const Stepper& stepper, const CartModel& model, const EffectSet& effects) {
   if constexpr (kCarriesState<Stepper, System>) {
@@ -191,6 +151,46 @@ std::unique_ptr<CartStepper> wrap(const Stepper& stepper, const IntegratorSettin
                               "' (known: autonomous, paper)");
 }
 
+/// A symmetric Birkhoffian member under reversible step control (reversible_cart_stepper.h).
+template <class Stepper>
+std::unique_ptr<CartStepper> wrap_reversible(const Stepper& stepper, const IntegratorSettings& settings,
+                                             const CartModel& model, const EffectSet& effects) {
+  if (settings.birkhoffian_form == "autonomous") {
+    return std::make_unique<ReversibleCartStepperAdapter<Stepper, CartAutonomousBirkhoffian>>(stepper, settings, model,
+                                                                                             effects);
+  }
+  if (settings.birkhoffian_form == "paper") {
+    return std::make_unique<ReversibleCartStepperAdapter<Stepper, CartPaperBirkhoffian>>(stepper, settings, model,
+                                                                                        effects);
+  }
+  throw std::invalid_argument("unknown birkhoffian_form '" + settings.birkhoffian_form +
+                              "' (known: autonomous, paper)");
+}
+
+/// The registry's symmetric Birkhoffian members, under reversible step control.
+std::unique_ptr<CartStepper> make_reversible(const IntegratorSettings& settings, const CollocationSettings& collocation,
+                                             const CartModel& model, const EffectSet& effects) {
+  const std::string& name = settings.name;
+  if (name == "birkhoff2") return wrap_reversible(GaussCollocation<1>(collocation), settings, model, effects);
+  if (name == "birkhoff4") {
+    return wrap_reversible(BirkhoffComposition<TripleJumpWeights>(collocation), settings, model, effects);
+  }
+  if (name == "birkhoff_gauss4") return wrap_reversible(GaussCollocation<2>(collocation), settings, model, effects);
+  if (name == "birkhoff_gauss6") return wrap_reversible(GaussCollocation<3>(collocation), settings, model, effects);
+  if (name == "birkhoff_gauss8") return wrap_reversible(GaussCollocation<4>(collocation), settings, model, effects);
+  if (name == "birkhoff4_suzuki") {
+    return wrap_reversible(BirkhoffComposition<SuzukiFiveWeights>(collocation), settings, model, effects);
+  }
+  if (name == "birkhoff6_kahan_li") {
+    return wrap_reversible(BirkhoffComposition<KahanLiSixWeights>(collocation), settings, model, effects);
+  }
+  if (name == "birkhoff8_kahan_li") {
+    return wrap_reversible(BirkhoffComposition<KahanLiEightWeights>(collocation), settings, model, effects);
+  }
+  throw std::invalid_argument("step_control 'reversible' is for the symmetric Birkhoffian members (" +
+                              reversible_names() + "), not '" + name + "'");
+}
+
 std::string known_names() {
   std::string list;
   for (const std::string& name : integrator_names()) list += (list.empty() ? "" : ", ") + name;
@@ -204,6 +204,11 @@ std::vector<std::string> integrator_names() {
           "rk4",                "dopri5",             "midpoint",
           "birkhoff_gauss4",    "birkhoff_gauss6",    "birkhoff_gauss8",
           "birkhoff4_suzuki",   "birkhoff6_kahan_li", "birkhoff8_kahan_li"};
+}
+
+std::vector<std::string> reversible_integrator_names() {
+  return {"birkhoff2",        "birkhoff4",          "birkhoff_gauss4",   "birkhoff_gauss6",
+          "birkhoff_gauss8",  "birkhoff4_suzuki",   "birkhoff6_kahan_li", "birkhoff8_kahan_li"};
 }
 
 std::unique_ptr<CartStepper> make_cart_stepper(const IntegratorSettings& settings, const CartModel& model,
@@ -224,6 +229,10 @@ std::unique_ptr<CartStepper> make_cart_stepper(const IntegratorSettings& setting
   collocation.max_iterations = settings.max_newton_iterations;
   collocation.compensated = settings.compensated_summation;
   collocation.estimate_local_error = settings.local_error_estimate;
+  if (settings.step_control == "reversible") return make_reversible(settings, collocation, model, effects);
+  if (settings.step_control != "fixed") {
+    throw std::invalid_argument("unknown step_control '" + settings.step_control + "' (known: fixed, reversible)");
+  }
   if (name == "birkhoff2") return wrap(GaussCollocation<1>(collocation), settings, model, effects);
   if (name == "birkhoff4") return wrap(BirkhoffComposition<TripleJumpWeights>(collocation), settings, model, effects);
   if (name == "birkhoff_gauss4") return wrap(GaussCollocation<2>(collocation), settings, model, effects);

@@ -38,6 +38,9 @@ class CartStepper {
 /// birkhoff_gauss8, birkhoff4_suzuki, birkhoff6_kahan_li, birkhoff8_kahan_li.
 std::vector<std::string> integrator_names();
 
+/// The members that take step_control "reversible" (the symmetric Birkhoffian ones).
+std::vector<std::string> reversible_integrator_names();
+
 /// Makes the named integrator for `model` and `effects` (both must outlive it). Throws
 /// std::invalid_argument for an unknown name (listing the known ones) or bad settings.
 std::unique_ptr<CartStepper> make_cart_stepper(const IntegratorSettings& settings, const CartModel& model,

@@ -160,6 +160,17 @@ struct CollocationMemory {
     cached = 0;
     next_slot = 0;
   }
+  /// The stage history and J of `other`, without its cached inverses (a side step's copy: the
+  /// inverses are h-specific and large).
+  void copy_history_from(const CollocationMemory& other) {
+    count = other.count;
+    times = other.times;
+    for (int m = 0; m < other.count; ++m) rates[m] = other.rates[m];
+    jacobian_valid = other.jacobian_valid;
+    jacobian = other.jacobian;
+    cached = 0;
+    next_slot = 0;
+  }
 };
 
 /// A point (z, y) with the round-off remainders that compensated summation carries between steps.

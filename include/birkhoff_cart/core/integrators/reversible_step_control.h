@@ -1,0 +1,187 @@
+// Reversible adaptive step size for the symmetric Birkhoffian members (docs/birkhoffian.md §11,
+// eqs. (B.36)–(B.39)): Hairer & Söderlind's explicit, time-reversible step-size control (SIAM J. Sci.
+// Comput. 26 (2005) 1838–1851; GNI §VIII.3.2), written for r = log ρ so that ρ stays positive.
+// With a step density σ(z, t) > 0 [1/s] (how fast the motion turns; the system's monitor, at least
+// σ₀), the step is h = ε/ρ where the control variable ρ = eʳ follows σ along the solution:
+//
+//   rₙ₊½ = rₙ + (ε/2) Γ(zₙ, tₙ)                                                          (B.36)
+//   hₙ = min(ε e^{−rₙ₊½}, h_max),   (zₙ₊₁, yₙ₊₁) = Φ_{hₙ}(zₙ, yₙ),   tₙ₊₁ = tₙ + hₙ        (B.37)
+//   rₙ₊₁ = rₙ₊½ + (ε/2) Γ(zₙ₊₁, tₙ₊₁),    Γ = σ̇ / σ² = (∂σ/∂w · ẇ + ∂σ/∂t) / σ²          (B.38)
+//
+// In the fictive time τ (dt/dτ = 1/ρ) log σ changes at the rate σ̇/ρ, which is Γ where ρ = σ; the
+// two half-updates of r are a trapezoidal rule in τ. Hairer–Söderlind update ρ itself by εσ̇/σ,
+// which can drive ρ negative where σ falls fast (it did on the stiff_hinge scene at ε = 0.25);
+// r = log ρ cannot. Φ is one step of a symmetric member (Gauss collocation or a symmetric
+// composition), so the map (rₙ, zₙ, yₙ, tₙ) ↦ (rₙ₊₁, zₙ₊₁, yₙ₊₁, tₙ₊₁) is symmetric: the same map
+// with −ε undoes it (each half-update of r uses the state at its own end, and h depends on rₙ₊½
+// alone). ε [rad] is the fictive-time step: the angle the motion turns in one step. Reversibility
+// holds for any σ; σ only decides where the steps go.
+//
+// G needs the derivative of σ along the flow: one evaluation of ẇ and one of σ on dual numbers
+// (forward-mode AD along ẇ), once per step (the G at the end of a step is the next step's first).
+//
+// Steps land on output instants without disturbing the grid: advance_to(t) takes the grid steps
+// that end at or before t, then the state at t itself comes from one extra step of Φ from the last
+// grid point (a side step, with a copy of the stage history): the grid, and with it the long-time
+// behaviour, does not depend on when the caller asks.
+#pragma once
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <string>
+
+#include "birkhoff_cart/core/autodiff.h"
+#include "birkhoff_cart/core/diagnostics.h"
+#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/integrators/gauss_collocation.h"
+
+namespace birkhoff_cart {
+
+/// Settings of the reversible controller.
+struct ReversibleStepSettings {
+  double fictive_step = 0.05;   ///< ε [rad]: the angle the motion turns per step (σ·h ≈ ε)
+  double density_floor = 1.0;   ///< σ₀ [1/s]: the slowest rate resolved (σ ≥ σ₀, so h ≤ ε/σ₀)
+  double max_step = std::numeric_limits<double>::infinity();  ///< h_max [s]: hₙ = min(ε/ρₙ₊½, h_max)
+};
+
+/// The grid of a reversible adaptive run: the carried point, its stage history, ρ, and t as hi + lo.
+/// `Carried` is CarriedCartState<System, Memory> or any type with `point`, `memory` and
+/// reduce_angles().
+template <class Stepper, class System, class Carried>
+class ReversibleStepControl {
+ public:
+  ReversibleStepControl(const Stepper& stepper, const ReversibleStepSettings& settings)
+      : stepper_(stepper), settings_(settings) {
+    if (!(settings.fictive_step > 0.0) || !std::isfinite(settings.fictive_step)) {
+      throw std::invalid_argument("reversible step control: fictive step ε must be finite and > 0 rad");
+    }
+    if (!(settings.max_step > 0.0)) throw std::invalid_argument("reversible step control: max_step must be > 0 s");
+    if (!(settings.density_floor > 0.0) || !std::isfinite(settings.density_floor)) {
+      throw std::invalid_argument("reversible step control: the step density floor must be finite and > 0 1/s");
+    }
+  }
+
+  const ReversibleStepSettings& settings() const { return settings_; }
+  double time() const { return time_ + time_low_; }  ///< grid time tₙ [s]
+  double control() const { return std::exp(log_rho_); }  ///< ρₙ [1/s]
+  Carried& grid() { return grid_; }
+  const Carried& grid() const { return grid_; }
+
+  /// Starts the grid at the carried point of `grid` (already set up by the caller; its stage
+  /// history is not taken) at time t [s]: ρ₀ = σ(z₀, t₀).
+  void start(System& system, const Carried& grid, double t, StepStatistics& statistics) {
+    grid_.point = grid.point;
+    grid_.steering_turns = grid.steering_turns;
+    grid_.heading_turns = grid.heading_turns;
+    grid_.periodic_in_steering_angle = grid.periodic_in_steering_angle;
+    grid_.valid = grid.valid;
+    grid_.memory.clear();
+    time_ = t;
+    time_low_ = 0.0;
+    system.begin_step(t);
+    double derivative = 0.0;
+    const double sigma = step_density(system, t, derivative, statistics);
+    log_rho_ = std::log(sigma);
+    gamma_ = derivative / (sigma * sigma);
+  }
+
+  /// The step the grid would take next with fictive step `epsilon` (±ε) [s].
+  double next_step(double epsilon) const { return step_for(epsilon, log_rho_ + 0.5 * epsilon * gamma_); }
+
+  /// One grid step (B.36)–(B.38) with fictive step ±ε (−ε undoes +ε). Returns h [s]. Throws StepError.
+  double grid_step(System& system, double epsilon, StepStatistics& statistics) {
+    const double log_rho_half = log_rho_ + 0.5 * epsilon * gamma_;
+    if (!std::isfinite(log_rho_half)) fail("met a non-finite step-size control variable log ρ", log_rho_half);
+    const double h = step_for(epsilon, log_rho_half);
+    const double t = time();
+    system.begin_step(t);
+    stepper_.advance_compensated(system, grid_.point, grid_.memory, t, h, statistics);
+    grid_.reduce_angles();
+    collocation_detail::two_sum(time_, h, time_, time_low_add_);
+    time_low_ += time_low_add_;
+    renormalize_time();
+    double derivative = 0.0;
+    const double sigma = step_density(system, time(), derivative, statistics);
+    gamma_ = derivative / (sigma * sigma);
+    log_rho_ = log_rho_half + 0.5 * epsilon * gamma_;
+    ++statistics.internal_steps;
+    const double size = std::abs(h);
+    statistics.internal_step_min = std::min(statistics.internal_step_min, size);
+    statistics.internal_step_max = std::max(statistics.internal_step_max, size);
+    return h;
+  }
+
+  /// Grid steps while the next one ends at or before `t` [s] (forward) — the grid never passes t.
+  void advance_grid_to(System& system, double t, StepStatistics& statistics) {
+    const double epsilon = settings_.fictive_step;
+    while (time() + next_step(epsilon) <= t) grid_step(system, epsilon, statistics);
+  }
+
+  /// The carried point at `t` ≥ time() [s] in `out`: the grid point itself when t is on it, else one
+  /// side step of Φ from the grid point with a copy of the stage history (the grid is untouched).
+  void side_step_to(System& system, double t, Carried& out, StepStatistics& statistics) const {
+    out.point = grid_.point;
+    out.steering_turns = grid_.steering_turns;
+    out.heading_turns = grid_.heading_turns;
+    out.periodic_in_steering_angle = grid_.periodic_in_steering_angle;
+    out.valid = grid_.valid;
+    const double delta = (t - time_) - time_low_;  // t − tₙ [s]
+    if (delta == 0.0) return;
+    out.memory.copy_history_from(grid_.memory);
+    system.begin_step(time());
+    stepper_.advance_compensated(system, out.point, out.memory, time(), delta, statistics);
+    out.reduce_angles();
+  }
+
+ private:
+  /// hₙ = ±min(|ε| e^{−rₙ₊½}, h_max): a function of rₙ₊½ alone, so −ε retraces +ε (B.37).
+  double step_for(double epsilon, double log_rho_half) const {
+    return std::copysign(std::min(std::abs(epsilon) * std::exp(-log_rho_half), settings_.max_step), epsilon);
+  }
+
+  void renormalize_time() {
+    const double sum = time_ + time_low_;
+    time_low_ = time_low_ - (sum - time_);
+    time_ = sum;
+  }
+
+  /// σ(z, t) and dσ/dt along the flow [1/s, 1/s²] (B.38); the system gives σ² (B.39).
+  double step_density(System& system, double t, double& derivative, StepStatistics& statistics) const {
+    using Dual = Jet<1>;
+    using W = StateVector<System, double>;
+    const W z = grid_.point.z + grid_.point.z_remainder;
+    const W w = system.to_darboux(z, t);
+    const W rate = system.darboux_rates(w, t);
+    ++statistics.rhs_evaluations;
+    StateVector<System, Dual> w_dual;
+    for (int k = 0; k < System::kDimension; ++k) {
+      w_dual(k) = Dual(w(k), Eigen::Matrix<double, 1, 1>(rate(k)));
+    }
+    const Dual t_dual(t, Eigen::Matrix<double, 1, 1>(1.0));
+    const Dual sigma_squared =
+        system.squared_step_density(system.from_darboux(w_dual, t_dual), t_dual, settings_.density_floor);
+    const double sigma = std::sqrt(sigma_squared.value());
+    derivative = 0.5 * sigma_squared.derivatives()(0) / sigma;
+    if (!std::isfinite(sigma) || !std::isfinite(derivative)) fail("met a non-finite step density σ", sigma);
+    return sigma;
+  }
+  [[noreturn]] void fail(const char* what, double value) const {
+    std::ostringstream message;
+    message.precision(17);
+    message << "reversible step control " << what << " (" << value << ") at t = " << time()
+            << " s; a smaller tolerance or max_step keeps it inside";
+    throw StepError(message.str());
+  }
+
+  Stepper stepper_;
+  ReversibleStepSettings settings_;
+  Carried grid_;
+  double time_ = 0.0;      ///< tₙ, high part [s]
+  double time_low_ = 0.0;  ///< tₙ, low part [s]
+  double time_low_add_ = 0.0;
+  double log_rho_ = 0.0;  ///< rₙ = log(ρₙ · 1 s) [-]
+  double gamma_ = 0.0;    ///< Γ(zₙ, tₙ) = σ̇/σ² [-]
+};
+
+}  // namespace birkhoff_cart

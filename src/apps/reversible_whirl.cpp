@@ -1,0 +1,184 @@
+// reversible_whirl: the reversible adaptive step against the same member at fixed steps on the
+// free jackknife_whirl (issue 12 goal; docs/accuracy.md §4, docs/benchmarks.md §8). ROS-free.
+//
+//   reversible_whirl [--duration T] [--member NAME] [--output-dir DIR]
+//   (defaults: 10 000 s, birkhoff_gauss4, bench/results; run from the repository)
+//
+// For the member at fixed steps h = 0.04 … 0.0025 s and under reversible control at tolerances
+// 1e-3 … 1e-8 m (horizon T), through Simulation exactly as cart_simulate runs them: the final
+// position error of hinge B against birkhoff_gauss8 at h = 2.5 ms (checked against h = 5 ms), the
+// rhs evaluations (the reversible runs include their pilots and step-density evaluations), CPU
+// time, and the energy residual |T* − T*₀| sampled every second: its max over the first and the
+// last tenth of the run. Prints the table and, for each reversible run, the fixed-step work needed
+// for the same error (log–log interpolation of the fixed-step curve). Writes
+// reversible_whirl.csv (the table) and reversible_whirl_trace.csv (t, energy residual and mean
+// step over each second, for the fixed step and the reversible run of about the same error).
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <exception>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/version.h"
+
+namespace {
+
+using namespace birkhoff_cart;
+
+struct Run {
+  std::string control;      ///< "fixed" or "reversible"
+  double setting = 0.0;     ///< h [s] or tolerance [m]
+  double error = 0.0;       ///< final position error [m]
+  double rhs = 0.0;         ///< rhs evaluations [-]
+  double steps = 0.0;       ///< steps (fixed) or internal steps (reversible) [-]
+  double cpu = 0.0;         ///< [s]
+  double energy_first = 0.0, energy_last = 0.0;  ///< max |T* − T*₀| over the first / last tenth [J]
+  std::vector<double> trace_energy, trace_step;  ///< per second: residual [J], mean internal step [s]
+};
+
+double cpu_seconds() { return static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
+
+Scene whirl(const std::string& member, double duration) {
+  Scene scene = load_scene("config/scenes/jackknife_whirl.yaml");
+  scene.integrator.name = member;
+  scene.duration = duration;
+  return scene;
+}
+
+/// Runs `scene` with output step 1 s (fixed: whole steps of h inside each second).
+Run run(const Scene& scene, double reference_x, double reference_y) {
+  Run result;
+  result.control = scene.integrator.step_control;
+  const bool fixed = result.control == "fixed";
+  result.setting = fixed ? scene.integrator.step_size : scene.integrator.tolerance;
+  Simulation simulation(scene);
+  const double duration = scene.duration;
+  const double start = cpu_seconds();
+  const long seconds = std::lround(duration);
+  const long steps_per_second = fixed ? std::lround(1.0 / scene.integrator.step_size) : 1;
+  std::uint64_t internal_before = 0;
+  for (long second = 1; second <= seconds; ++second) {
+    for (long k = 0; k < steps_per_second; ++k) simulation.step();
+    const double residual = std::abs(simulation.diagnostics().energy_balance_residual);
+    if (second <= seconds / 10) result.energy_first = std::max(result.energy_first, residual);
+    if (second > seconds - seconds / 10) result.energy_last = std::max(result.energy_last, residual);
+    result.trace_energy.push_back(residual);
+    const std::uint64_t internal = simulation.statistics().internal_steps;
+    result.trace_step.push_back(fixed ? scene.integrator.step_size
+                                      : 1.0 / static_cast<double>(std::max<std::uint64_t>(1, internal - internal_before)));
+    internal_before = internal;
+  }
+  result.cpu = cpu_seconds() - start;
+  result.rhs = static_cast<double>(simulation.statistics().rhs_evaluations);
+  result.steps = static_cast<double>(fixed ? simulation.statistics().steps : simulation.statistics().internal_steps);
+  result.error = std::hypot(simulation.state().x - reference_x, simulation.state().y - reference_y);
+  return result;
+}
+
+/// Fixed-step rhs evaluations for `error` by log–log interpolation of the fixed runs (NaN outside).
+double fixed_work_for(const std::vector<Run>& fixed, double error) {
+  for (std::size_t i = 0; i + 1 < fixed.size(); ++i) {
+    const Run& a = fixed[i];
+    const Run& b = fixed[i + 1];
+    if ((a.error - error) * (b.error - error) <= 0.0 && a.error != b.error) {
+      const double s = std::log(error / a.error) / std::log(b.error / a.error);
+      return std::exp(std::log(a.rhs) + s * std::log(b.rhs / a.rhs));
+    }
+  }
+  return std::nan("");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) try {
+  birkhoff_cart::print_version_if_asked(argc, argv, "reversible_whirl");
+  double duration = 10000.0;
+  std::string member = "birkhoff_gauss4";
+  std::string output_dir = "bench/results";
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (i + 1 >= argc) throw std::invalid_argument("option " + arg + " needs a value");
+    if (arg == "--duration") duration = std::stod(argv[++i]);
+    else if (arg == "--member") member = argv[++i];
+    else if (arg == "--output-dir") output_dir = argv[++i];
+    else throw std::invalid_argument("unknown argument '" + arg + "'");
+  }
+  if (!(duration >= 10.0) || duration != std::round(duration)) {
+    throw std::invalid_argument("--duration must be a whole number of seconds >= 10");
+  }
+
+  // Reference: gauss8 at 2.5 ms, checked against 5 ms.
+  Scene reference_scene = whirl("birkhoff_gauss8", duration);
+  reference_scene.integrator.step_size = 2.5e-3;
+  Simulation reference(reference_scene);
+  while (!reference.at_end()) reference.step_on_schedule();
+  reference_scene.integrator.step_size = 5e-3;
+  Simulation check(reference_scene);
+  while (!check.at_end()) check.step_on_schedule();
+  const double rx = reference.state().x, ry = reference.state().y;
+  const double reference_spread = std::hypot(check.state().x - rx, check.state().y - ry);
+  std::printf("reversible_whirl: jackknife_whirl over %.0f s, member %s; reference gauss8 h = 2.5 ms, "
+              "which differs from h = 5 ms by %.2e m\n\n",
+              duration, member.c_str(), reference_spread);
+
+  std::vector<Run> fixed, reversible;
+  for (double h : {0.04, 0.02, 0.01, 0.005, 0.0025}) {
+    Scene scene = whirl(member, duration);
+    scene.integrator.step_size = h;
+    fixed.push_back(run(scene, rx, ry));
+  }
+  for (double tolerance : {1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8}) {
+    Scene scene = whirl(member, duration);
+    scene.integrator.step_control = "reversible";
+    scene.integrator.tolerance = tolerance;
+    scene.integrator.step_size = 1.0;  // the output step
+    reversible.push_back(run(scene, rx, ry));
+  }
+
+  std::printf("%-10s %9s %11s %10s %12s %8s %12s %12s %7s %14s\n", "control", "setting", "error [m]", "steps", "rhs evals",
+              "CPU [s]", "E first [J]", "E last [J]", "last/1st", "fixed rhs/ours");
+  const std::string csv_path = output_dir + "/reversible_whirl.csv";
+  std::FILE* csv = std::fopen(csv_path.c_str(), "w");
+  if (!csv) throw std::runtime_error("cannot write " + csv_path);
+  std::fprintf(csv, "member,control,setting,error_m,steps,rhs_evaluations,cpu_s,energy_first_tenth_J,energy_last_tenth_J,"
+                    "fixed_rhs_for_same_error\n");
+  for (const std::vector<Run>* group : {&fixed, &reversible}) {
+    for (const Run& r : *group) {
+      const double fixed_work = r.control == "fixed" ? std::nan("") : fixed_work_for(fixed, r.error);
+      std::printf("%-10s %9.3g %11.3e %10.4g %12.4g %8.2f %12.3e %12.3e %7.2f %14.3g\n", r.control.c_str(), r.setting,
+                  r.error, r.steps, r.rhs, r.cpu, r.energy_first, r.energy_last, r.energy_last / r.energy_first, fixed_work / r.rhs);
+      std::fprintf(csv, "%s,%s,%.6g,%.6e,%.0f,%.0f,%.4f,%.6e,%.6e,%.6g\n", member.c_str(), r.control.c_str(), r.setting,
+                   r.error, r.steps, r.rhs, r.cpu, r.energy_first, r.energy_last, fixed_work);
+    }
+  }
+  std::fclose(csv);
+
+  // Trace: the reversible run and the fixed run closest to it in final error.
+  const Run* pair_reversible = &reversible[2];
+  const Run* pair_fixed = &fixed[0];
+  for (const Run& r : fixed) {
+    if (std::abs(std::log(r.error / pair_reversible->error)) < std::abs(std::log(pair_fixed->error / pair_reversible->error))) {
+      pair_fixed = &r;
+    }
+  }
+  const std::string trace_path = output_dir + "/reversible_whirl_trace.csv";
+  std::FILE* trace = std::fopen(trace_path.c_str(), "w");
+  if (!trace) throw std::runtime_error("cannot write " + trace_path);
+  std::fprintf(trace, "# fixed h = %g s (final error %.3e m), reversible tolerance %g m (final error %.3e m)\n",
+               pair_fixed->setting, pair_fixed->error, pair_reversible->setting, pair_reversible->error);
+  std::fprintf(trace, "t_s,fixed_energy_residual_J,fixed_step_s,reversible_energy_residual_J,reversible_mean_step_s\n");
+  for (std::size_t k = 0; k < pair_fixed->trace_energy.size(); ++k) {
+    std::fprintf(trace, "%zu,%.6e,%.6g,%.6e,%.6g\n", k + 1, pair_fixed->trace_energy[k], pair_fixed->trace_step[k],
+                 pair_reversible->trace_energy[k], pair_reversible->trace_step[k]);
+  }
+  std::fclose(trace);
+  std::printf("\nwrote %s and %s\n", csv_path.c_str(), trace_path.c_str());
+  return 0;
+} catch (const std::exception& error) {
+  std::fprintf(stderr, "reversible_whirl: %s\n", error.what());
+  return 2;
+}

@@ -1,0 +1,212 @@
+// The CartStepper of a symmetric Birkhoffian member under reversible step control
+// (reversible_step_control.h; docs/birkhoffian.md §11): the caller's step h is the output step, the
+// member's own grid is chosen by the controller, and the state at each output instant comes from a
+// side step off the grid. Private to the core library (cart_stepper.cpp makes it).
+//
+// Tolerance → ε (§11.3, eq. (B.40)). The global position error of a run with fixed ε behaves like
+// C·ε^p·(t − t₀) (symmetric member of order p; the error of a whirl grows like its phase error,
+// linearly). Before the first step the adapter measures C on a pilot window [t₀, t₀ + W],
+// W = min(horizon, 60 s): three pilot runs from the start state with ε_a, ε_a/2, ε_a/4 land at
+// t₀ + W; their position differences d₁, d₂ give the observed order and the error of the finest,
+// e = d₂ / (2^q − 1). ε_a is halved (twice at most) until the observed ratio d₁/d₂ is within a
+// factor 2 of 2^p (the asymptotic regime, q = p); otherwise q = log₂(d₁/d₂) clamped to [1, p] (a
+// load with a kink lowers the order). Then ε = ε_a/4 · (0.5·tol·W / (e·horizon))^{1/q}. The run itself starts
+// again from the start state: the pilots only choose ε, which is then fixed for the whole run and
+// after every reset (the map stays reversible and the run deterministic).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+
+#include "birkhoff_cart/core/effects.h"
+#include "birkhoff_cart/core/integrators/carried_state.h"
+#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/integrators/reversible_step_control.h"
+#include "birkhoff_cart/core/scene.h"
+#include "step_checks.h"
+
+namespace birkhoff_cart {
+
+/// What the pilot runs found (summaries, tests).
+struct ReversibleCalibration {
+  double fictive_step = 0.0;      ///< ε chosen [rad]
+  double pilot_window = 0.0;      ///< W [s]
+  double pilot_error = 0.0;       ///< e of the finest pilot at t₀ + W [m]
+  double pilot_fictive_step = 0.0;  ///< ε of the finest pilot [rad]
+  double observed_ratio = 0.0;    ///< d₁/d₂ (2^p in the asymptotic regime) [-]
+  double observed_order = 0.0;    ///< the order ε was extrapolated with [-]
+  bool at_round_off = false;      ///< the pilots agreed to round-off: ε is the largest allowed
+};
+
+template <class Stepper, class System>
+class ReversibleCartStepperAdapter final : public CartStepper {
+  using Memory = typename Stepper::template Memory<System>;
+  using Carried = CarriedCartState<System, Memory>;
+  using Control = ReversibleStepControl<Stepper, System, Carried>;
+
+ public:
+  static constexpr double kMaxFictiveStep = 0.2;    ///< ε_max [rad]: at 0.3 the gauss4 whirl's energy drifted
+  static constexpr double kMinFictiveStep = 1e-6;   ///< ε_min [rad]: a tolerance below reach
+  static constexpr double kPilotWindow = 60.0;      ///< longest pilot window [s]
+  static constexpr int kMaxPilotAttempts = 8;       ///< halvings of ε_a after failed steps before giving up
+  static constexpr int kPilotAttemptsForOrder = 2;  ///< halvings of ε_a waiting for the order p
+
+  ReversibleCartStepperAdapter(const Stepper& stepper, const IntegratorSettings& settings, const CartModel& model,
+                               const EffectSet& effects)
+      : stepper_(stepper), system_(model, effects), effects_(&effects), settings_(settings), name_(Stepper::name()) {
+    if (!(settings.tolerance > 0.0) || !std::isfinite(settings.tolerance)) {
+      throw std::invalid_argument("step_control 'reversible' needs a finite tolerance > 0 m, got " +
+                                  std::to_string(settings.tolerance));
+    }
+    if (!(settings.max_step > 0.0)) throw std::invalid_argument("integrator.max_step must be > 0 s");
+    if (!(settings.tolerance_horizon > 0.0) || !std::isfinite(settings.tolerance_horizon)) {
+      throw std::invalid_argument("integrator.tolerance_horizon must be finite and > 0 s");
+    }
+  }
+
+  const std::string& name() const override { return name_; }
+  int order() const override { return Stepper::kOrder; }
+  bool symmetric() const override { return true; }
+  const std::optional<ReversibleCalibration>& calibration() const { return calibration_; }
+
+  void step(CartState& state, double step_size, StepStatistics& statistics) override {
+    stepper_checks::require_valid_step_size(step_size);
+    const double time = state.time;  // tₖ [s]
+    const double target = time + step_size;
+    StepStatistics counted = statistics;
+    counted.newton_iterations_last_step = 0;
+    const bool continues = valid_ && output_.continues(state) && !commands_changed();
+    valid_ = false;  // on failure: the next step starts afresh from the caller's unchanged state
+    try {
+      if (!calibration_) calibrate(state, counted);
+      if (!continues) start(state, counted);
+      control_->advance_grid_to(system_, target, counted);
+      control_->side_step_to(system_, target, output_, counted);
+    } catch (const StepError& error) {
+      throw StepError(name_ + " (reversible step control): " + error.what());
+    }
+    const auto& point = output_.point;
+    stepper_checks::require_finite_result(name_, time, step_size, point.z, point.y);
+    const CartState next = output_.output(system_, target);
+    stepper_checks::require_finite_speeds(name_, time, step_size, next);
+    remember_commands();
+    valid_ = true;
+    ++counted.steps;
+    state = next;
+    statistics = counted;
+  }
+
+ private:
+  /// A grid from `state`: the carried point with χ, θ reduced, ρ₀ = σ(z₀).
+  void start(const CartState& state, StepStatistics& statistics) {
+    Carried seed;
+    system_.begin_step(state.time);
+    seed.start_from(system_, state);
+    ReversibleStepSettings control_settings;
+    control_settings.fictive_step = calibration_->fictive_step;
+    control_settings.max_step = settings_.max_step;
+    control_ = std::make_unique<Control>(stepper_, control_settings);
+    control_->start(system_, seed, state.time, statistics);
+  }
+
+  /// The position (x, y) [m] at t₀ + window of a run from `state` with fictive step ε.
+  Eigen::Vector2d pilot(const CartState& state, double epsilon, double window, StepStatistics& statistics) {
+    Carried seed;
+    system_.begin_step(state.time);
+    seed.start_from(system_, state);
+    ReversibleStepSettings control_settings;
+    control_settings.fictive_step = epsilon;
+    control_settings.max_step = settings_.max_step;
+    Control control(stepper_, control_settings);
+    control.start(system_, seed, state.time, statistics);
+    const double end = state.time + window;
+    control.advance_grid_to(system_, end, statistics);
+    Carried landed;
+    control.side_step_to(system_, end, landed, statistics);
+    return Eigen::Vector2d(landed.point.y(kXIndex) + landed.point.y_remainder(kXIndex),
+                           landed.point.y(kYIndex) + landed.point.y_remainder(kYIndex));
+  }
+
+  /// ε for the tolerance from three pilot runs (file comment; eq. (B.40)).
+  void calibrate(const CartState& state, StepStatistics& statistics) {
+    constexpr int p = Stepper::kOrder;
+    const double ratio_expected = std::pow(2.0, p);
+    const double window = std::min(settings_.tolerance_horizon, kPilotWindow);
+    ReversibleCalibration found;
+    found.pilot_window = window;
+    double epsilon = kMaxFictiveStep;
+    for (int attempt = 0;; ++attempt) {
+      Eigen::Vector2d coarse, middle, fine;
+      try {
+        coarse = pilot(state, epsilon, window, statistics);
+        middle = pilot(state, epsilon / 2.0, window, statistics);
+        fine = pilot(state, epsilon / 4.0, window, statistics);
+      } catch (const StepError&) {  // too coarse for the stage solve: finer pilots
+        if (attempt == kMaxPilotAttempts) throw;
+        epsilon /= 2.0;
+        continue;
+      }
+      const double d1 = (coarse - middle).norm();
+      const double d2 = (middle - fine).norm();
+      const double noise = 1e-13 * (1.0 + fine.norm());  // [m]
+      found.pilot_fictive_step = epsilon / 4.0;
+      found.observed_ratio = d1 / d2;
+      if (d1 <= noise && d2 <= noise) {  // already at round-off at the largest ε tried
+        found.at_round_off = true;
+        found.pilot_error = d2;
+        found.fictive_step = epsilon;
+        break;
+      }
+      const bool asymptotic = d2 > noise && found.observed_ratio > 0.5 * ratio_expected &&
+                              found.observed_ratio < 2.0 * ratio_expected;
+      if (asymptotic || attempt >= kPilotAttemptsForOrder) {
+        // A load with a kink in time (a torque ramp's corners) or in the state (|v| v drag) lowers
+        // the order the run shows: extrapolate with the order observed, 1 ≤ q ≤ p, not with p.
+        const double order =
+            asymptotic ? p : std::clamp(std::log2(std::max(found.observed_ratio, 2.0)), 1.0, double(p));
+        found.observed_order = order;
+        found.pilot_error = d2 / (std::pow(2.0, order) - 1.0);
+        const double allowed = 0.5 * settings_.tolerance * window / settings_.tolerance_horizon;  // [m] at W
+        found.fictive_step = epsilon / 4.0 * std::pow(allowed / std::max(found.pilot_error, noise), 1.0 / order);
+        break;
+      }
+      epsilon /= 2.0;
+    }
+    found.fictive_step = std::min(found.fictive_step, kMaxFictiveStep);
+    if (!(found.fictive_step >= kMinFictiveStep)) {
+      std::ostringstream message;
+      message << "tolerance " << settings_.tolerance << " m is out of reach for " << name_ << " (it would need ε = "
+              << found.fictive_step << " rad < " << kMinFictiveStep << "): use a higher-order member or a looser tolerance";
+      throw StepError(message.str());
+    }
+    calibration_ = found;
+  }
+
+  bool commands_changed() const {
+    const auto& steering = effects_->steering_command();
+    const auto& drive = effects_->drive_command();
+    return (steering && steering->value != steering_command_) || (drive && drive->value != drive_command_);
+  }
+  void remember_commands() {
+    if (effects_->steering_command()) steering_command_ = effects_->steering_command()->value;
+    if (effects_->drive_command()) drive_command_ = effects_->drive_command()->value;
+  }
+
+  Stepper stepper_;
+  System system_;
+  const EffectSet* effects_;
+  IntegratorSettings settings_;
+  std::string name_;
+  std::optional<ReversibleCalibration> calibration_;
+  std::unique_ptr<Control> control_;
+  Carried output_;
+  bool valid_ = false;
+  double steering_command_ = 0.0;  ///< the commands the grid was started or continued with [N·m]
+  double drive_command_ = 0.0;
+};
+
+}  // namespace birkhoff_cart

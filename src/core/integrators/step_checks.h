@@ -1,0 +1,69 @@
+// The checks every CartStepper adapter makes (cart_stepper.cpp, reversible_cart_stepper.h): a
+// valid step size in, finite coordinates and quasi-velocities out, with errors that name the
+// coordinate. Private to the core library.
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/state.h"
+
+namespace birkhoff_cart {
+namespace stepper_checks {
+
+inline const char* const kBirkhoffianNames[kBirkhoffianSize] = {"arc_length pi1", "steering_angle chi",
+                                                        "forward momentum p1", "steering momentum p2"};
+inline const char* const kPassiveNames[kPassiveSize] = {"x",
+                                                 "y",
+                                                 "heading theta",
+                                                 "wheel_spin_angle phi1",
+                                                 "wheel_spin_angle phi2",
+                                                 "wheel_spin_angle phi3",
+                                                 "wheel_spin_angle phi4",
+                                                 "applied_work W",
+                                                 "steering_impulse I2"};
+
+inline void require_valid_step_size(double step_size) {
+  if (!(step_size > 0.0) || !std::isfinite(step_size)) {
+    std::ostringstream message;
+    message << "step size must be finite and > 0 s, got " << step_size;
+    throw std::invalid_argument(message.str());
+  }
+}
+
+[[noreturn]] inline void throw_non_finite(const std::string& integrator, double time, double step_size,
+                                   const std::string& quantity, double value) {
+  std::ostringstream message;
+  message.precision(17);
+  message << integrator << " step from t = " << time << " s (h = " << step_size << " s) produced a non-finite "
+          << quantity << " (" << value << ")";
+  throw StepError(message.str());
+}
+
+/// Throws StepError naming the first non-finite coordinate of (z, y) or quasi-velocity of `next`:
+/// what every adapter checks before it hands a step's result out.
+inline void require_finite_result(const std::string& integrator, double time, double step_size,
+                           const Eigen::Matrix<double, kBirkhoffianSize, 1>& z,
+                           const Eigen::Matrix<double, kPassiveSize, 1>& y) {
+  for (int i = 0; i < kBirkhoffianSize; ++i) {
+    if (!std::isfinite(z(i))) throw_non_finite(integrator, time, step_size, kBirkhoffianNames[i], z(i));
+  }
+  for (int i = 0; i < kPassiveSize; ++i) {
+    if (!std::isfinite(y(i))) throw_non_finite(integrator, time, step_size, kPassiveNames[i], y(i));
+  }
+}
+inline void require_finite_speeds(const std::string& integrator, double time, double step_size, const CartState& next) {
+  if (!std::isfinite(next.forward_speed)) {
+    throw_non_finite(integrator, time, step_size, "forward_speed omega1 (singular mass matrix?)", next.forward_speed);
+  }
+  if (!std::isfinite(next.steering_rate)) {
+    throw_non_finite(integrator, time, step_size, "steering_rate omega2 (singular mass matrix?)", next.steering_rate);
+  }
+}
+
+}  // namespace stepper_checks
+}  // namespace birkhoff_cart
