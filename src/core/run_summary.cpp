@@ -32,6 +32,15 @@ std::string run_summary(const Simulation& simulation, const AccuracyGuard& guard
                 diagnostics.p2_balance_residual, diagnostics.max_constraint_residual);
   text += line;
   text += "  " + local_error_estimate_summary(statistics, simulation.integrator_name()) + "\n";
+  if (statistics.internal_steps > 0) {
+    std::snprintf(line, sizeof line,
+                  "  reversible step control: tolerance %.3g m, eps = %.4g rad (pilot order %.2g), %llu internal steps "
+                  "from %.3g s to %.3g s\n",
+                  simulation.scene().integrator.tolerance, statistics.control_fictive_step,
+                  statistics.control_observed_order, static_cast<unsigned long long>(statistics.internal_steps),
+                  statistics.internal_step_min, statistics.internal_step_max);
+    text += line;
+  }
   text += "  accuracy: " + guard.summary() + "\n";
   return text;
 }

@@ -58,6 +58,8 @@ class CartBirkhoffianBase {
   /// Are the rates 2π-periodic in χ (no enabled load that grows with χ)?
   bool periodic_in_steering_angle() const { return effects_->periodic_in_steering_angle(); }
   bool non_birkhoffian_force_enabled() const { return non_birkhoffian_force_enabled_; }
+  /// Do the rates change with t at a fixed state (an enabled time profile)?
+  bool depends_on_time() const { return non_birkhoffian_force_enabled_ && effects_->depends_on_time(); }
   /// Disabled: Λ = 0 and no applied loads (the Birkhoffian part; K-symplecticity tests).
   void set_non_birkhoffian_force_enabled(bool enabled) { non_birkhoffian_force_enabled_ = enabled; }
 

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -43,6 +45,12 @@ class Effect {
   virtual void add_to(const EffectInput& input, GeneralizedForce& total) const = 0;
   /// Is Q 2π-periodic in the steering angle χ? (Lets the integrators keep χ reduced; a hinge spring is not.)
   virtual bool periodic_in_steering_angle() const { return true; }
+  /// Does Q change with time t at a fixed state (a torque profile)? (The reversible step control
+  /// then adds ∂σ/∂t to its step density's rate.)
+  virtual bool depends_on_time() const { return false; }
+  /// The first time > t [s] where Q is not smooth in t (a torque step, a ramp's corners); +∞ if
+  /// none. Integrators that choose their own steps land on it (reversible_cart_stepper.h).
+  virtual double next_kink_after(double /*t*/) const { return std::numeric_limits<double>::infinity(); }
 };
 
 /// The enabled effects of a scene.
@@ -56,6 +64,19 @@ class EffectSet {
       if (!effect->periodic_in_steering_angle()) return false;
     }
     return true;
+  }
+  /// Any enabled effect that changes with t at a fixed state?
+  bool depends_on_time() const {
+    for (const auto& effect : effects_) {
+      if (effect->depends_on_time()) return true;
+    }
+    return false;
+  }
+  /// The first time > t [s] where any enabled effect has a kink in time; +∞ if none.
+  double next_kink_after(double t) const {
+    double kink = std::numeric_limits<double>::infinity();
+    for (const auto& effect : effects_) kink = std::min(kink, effect->next_kink_after(t));
+    return kink;
   }
   std::size_t size() const { return effects_.size(); }
   const std::vector<std::unique_ptr<Effect>>& effects() const { return effects_; }

@@ -48,6 +48,8 @@ struct TorqueProfile {
   double start_time = 0.0;       ///< [s]
   double end_time = 0.0;         ///< [s]
   double switch_off_time = 0.0;  ///< [s]
+  /// The first time > t [s] where the profile is not smooth (a step, a ramp's corners); +∞ if none.
+  double next_kink_after(double t) const;
   double width = 1.0;            ///< [s]
 
   /// The torque at time t [N·m] (for kCommand: `value`; the effect reads its command input).

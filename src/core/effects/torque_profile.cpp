@@ -1,5 +1,6 @@
 // Torque time profiles of the steering and drive torques (docs/scenes.md "Torque profiles").
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -29,6 +30,19 @@ double TorqueProfile::at(double time) const {
       return initial * 0.5 * (1.0 - std::tanh((time - switch_off_time) / width));
   }
   return 0.0;
+}
+
+double TorqueProfile::next_kink_after(double t) const {
+  double kink = std::numeric_limits<double>::infinity();
+  const auto consider = [&](double time) {
+    if (time > t && time < kink) kink = time;
+  };
+  if (kind == Kind::kStep) consider(step_time);
+  if (kind == Kind::kRamp) {
+    consider(start_time);
+    consider(end_time);
+  }
+  return kink;
 }
 
 void validate_torque_profile(const std::string& effect_name, const TorqueProfile& profile) {

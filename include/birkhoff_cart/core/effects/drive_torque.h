@@ -16,6 +16,8 @@ class DriveTorque : public Effect {
   /// Q1 += T cos χ / r1;  ∂Q1/∂χ += −T sin χ / r1.
   void add_to(const EffectInput& input, GeneralizedForce& total) const override;
   const TorqueSource& source() const { return source_; }
+  bool depends_on_time() const override { return source_.depends_on_time(); }
+  double next_kink_after(double t) const override { return source_.next_kink_after(t); }
 
  private:
   TorqueSource source_;

@@ -15,6 +15,8 @@ class SteeringTorque : public Effect {
   /// Q += (0, τ(t)); ∂Q/∂(χ, ω1, ω2) = 0.
   void add_to(const EffectInput& input, GeneralizedForce& total) const override;
   const TorqueSource& source() const { return source_; }
+  bool depends_on_time() const override { return source_.depends_on_time(); }
+  double next_kink_after(double t) const override { return source_.next_kink_after(t); }
 
  private:
   TorqueSource source_;

@@ -1,6 +1,7 @@
 // Where a torque effect takes its torque from: a time profile or a shared command input.
 #pragma once
 
+#include <limits>
 #include <memory>
 
 #include "birkhoff_cart/core/effects.h"
@@ -17,6 +18,13 @@ class TorqueSource {
   /// The torque at time t [N·m].
   double at(double time) const { return command_ ? command_->value : profile_.at(time); }
 
+  /// A profile that varies in time (a command is held constant between commands).
+  bool depends_on_time() const { return !command_ && profile_.kind != TorqueProfile::Kind::kConstant; }
+  /// The first time > t [s] where the torque has a kink or jump (none for a command: its changes
+  /// are seen by the integrators as command changes).
+  double next_kink_after(double t) const {
+    return command_ ? std::numeric_limits<double>::infinity() : profile_.next_kink_after(t);
+  }
   const TorqueProfile& profile() const { return profile_; }
   const std::shared_ptr<CommandInput>& command() const { return command_; }
 
