@@ -103,7 +103,7 @@ class CartBirkhoffianBase {
   }
 
   /// The squared step density of the reversible step control (reversible_step_control.h,
-  /// docs/birkhoffian.md §11, eq. (B.39)) [1/s²]:
+  /// docs/birkhoffian.md §11, eq. (B.44)) [1/s²]:
   ///   σ² = ω2² + θ̇² + √((ω̇1/l)² + ω̇2² + σ₀⁴),   θ̇ = ω1 sin χ / l (eq. (2.3)),
   /// how fast the front axle turns against the body and the body against the ground, and how fast
   /// those rates change (a hinge spring's swing, a torque's push). On the jackknife whirl χ turns at

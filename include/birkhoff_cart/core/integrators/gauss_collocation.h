@@ -170,6 +170,12 @@ struct CollocationMemory {
     jacobian = other.jacobian;
     cached = 0;
     next_slot = 0;
+    end_rate_valid = other.end_rate_valid;
+    end_time = other.end_time;
+    end_point = other.end_point;
+    end_rate = other.end_rate;
+    end_passive_point = other.end_passive_point;
+    end_passive_rate = other.end_passive_rate;
   }
 };
 

@@ -1,12 +1,12 @@
 // Reversible adaptive step size for the symmetric Birkhoffian members (docs/birkhoffian.md §11,
-// eqs. (B.36)–(B.39)): Hairer & Söderlind's explicit, time-reversible step-size control (SIAM J. Sci.
+// eqs. (B.41)–(B.44)): Hairer & Söderlind's explicit, time-reversible step-size control (SIAM J. Sci.
 // Comput. 26 (2005) 1838–1851; GNI §VIII.3.2), written for r = log ρ so that ρ stays positive.
 // With a step density σ(z, t) > 0 [1/s] (how fast the motion turns; the system's monitor, at least
 // σ₀), the step is h = ε/ρ where the control variable ρ = eʳ follows σ along the solution:
 //
-//   rₙ₊½ = rₙ + (ε/2) Γ(zₙ, tₙ)                                                          (B.36)
-//   hₙ = min(ε e^{−rₙ₊½}, h_max),   (zₙ₊₁, yₙ₊₁) = Φ_{hₙ}(zₙ, yₙ),   tₙ₊₁ = tₙ + hₙ        (B.37)
-//   rₙ₊₁ = rₙ₊½ + (ε/2) Γ(zₙ₊₁, tₙ₊₁),    Γ = σ̇ / σ² = (∂σ/∂w · ẇ + ∂σ/∂t) / σ²          (B.38)
+//   rₙ₊½ = rₙ + (ε/2) Γ(zₙ, tₙ)                                                          (B.41)
+//   hₙ = min(ε e^{−rₙ₊½}, h_max),   (zₙ₊₁, yₙ₊₁) = Φ_{hₙ}(zₙ, yₙ),   tₙ₊₁ = tₙ + hₙ        (B.42)
+//   rₙ₊₁ = rₙ₊½ + (ε/2) Γ(zₙ₊₁, tₙ₊₁),    Γ = σ̇ / σ² = (∂σ/∂w · ẇ + ∂σ/∂t) / σ²          (B.43)
 //
 // In the fictive time τ (dt/dτ = 1/ρ) log σ changes at the rate σ̇/ρ, which is Γ where ρ = σ; the
 // two half-updates of r are a trapezoidal rule in τ. Hairer–Söderlind update ρ itself by εσ̇/σ,
@@ -89,7 +89,7 @@ class ReversibleStepControl {
   /// The step the grid would take next with fictive step `epsilon` (±ε) [s].
   double next_step(double epsilon) const { return step_for(epsilon, log_rho_ + 0.5 * epsilon * gamma_); }
 
-  /// One grid step (B.36)–(B.38) with fictive step ±ε (−ε undoes +ε). Returns h [s]. Throws StepError.
+  /// One grid step (B.41)–(B.43) with fictive step ±ε (−ε undoes +ε). Returns h [s]. Throws StepError.
   double grid_step(System& system, double epsilon, StepStatistics& statistics) {
     const double log_rho_half = log_rho_ + 0.5 * epsilon * gamma_;
     if (!std::isfinite(log_rho_half)) fail("met a non-finite step-size control variable log ρ", log_rho_half);
@@ -135,7 +135,7 @@ class ReversibleStepControl {
   }
 
  private:
-  /// hₙ = ±min(|ε| e^{−rₙ₊½}, h_max): a function of rₙ₊½ alone, so −ε retraces +ε (B.37).
+  /// hₙ = ±min(|ε| e^{−rₙ₊½}, h_max): a function of rₙ₊½ alone, so −ε retraces +ε (B.42).
   double step_for(double epsilon, double log_rho_half) const {
     return std::copysign(std::min(std::abs(epsilon) * std::exp(-log_rho_half), settings_.max_step), epsilon);
   }
@@ -146,14 +146,21 @@ class ReversibleStepControl {
     time_ = sum;
   }
 
-  /// σ(z, t) and dσ/dt along the flow [1/s, 1/s²] (B.38); the system gives σ² (B.39).
+  /// σ(z, t) and dσ/dt along the flow [1/s, 1/s²] (B.43); the system gives σ² (B.44).
   double step_density(System& system, double t, double& derivative, StepStatistics& statistics) const {
     using Dual = Jet<1>;
     using W = StateVector<System, double>;
     const W z = grid_.point.z + grid_.point.z_remainder;
     const W w = system.to_darboux(z, t);
-    const W rate = system.darboux_rates(w, t);
-    ++statistics.rhs_evaluations;
+    // ẇ at the grid point: the step's own F(w⁺, tₙ₊₁) when its local error estimate left one there
+    // (first same as last), else one evaluation.
+    W rate;
+    if (grid_.memory.end_rate_belongs_to(w, t)) {
+      rate = grid_.memory.end_rate;
+    } else {
+      rate = system.darboux_rates(w, t);
+      ++statistics.rhs_evaluations;
+    }
     StateVector<System, Dual> w_dual;
     for (int k = 0; k < System::kDimension; ++k) {
       w_dual(k) = Dual(w(k), Eigen::Matrix<double, 1, 1>(rate(k)));
