@@ -7,12 +7,12 @@
 // C·ε^p·(t − t₀) (symmetric member of order p; the error of a whirl grows like its phase error,
 // linearly). Before the first step the adapter measures C on a pilot window [t₀, t₀ + W],
 // W = min(horizon, 60 s): three pilot runs from the start state with ε_a, ε_a/2, ε_a/4 land at
-// t₀ + W; their position differences d₁, d₂ give the observed order and the error of the finest,
-// e = d₂ / (2^q − 1). ε_a is halved (twice at most) until the observed ratio d₁/d₂ is within a
-// factor 2 of 2^p (the asymptotic regime, q = p); otherwise q = log₂(d₁/d₂) clamped to [1, p] (a
-// load with a kink lowers the order). Then ε = ε_a/4 · (0.5·tol·W / (e·horizon))^{1/q}. The run itself starts
-// again from the start state: the pilots only choose ε, which is then fixed for the whole run and
-// after every reset (the map stays reversible and the run deterministic).
+// t₀ + W; their position differences d₁, d₂ give the observed order q and the error of the finest,
+// e = d₂ / (2^q − 1). ε_a starts at 2 ε_max and is halved while a pilot fails, and (twice at most)
+// until d₁/d₂ is within a factor 2 of 2^p (q = p); otherwise q = log₂(d₁/d₂) in [1, p] (a load with
+// a kink lowers the order). Then ε = min(ε_a/4 · (0.5·tol·W / (e·horizon))^{1/q}, ε_a, ε_max). The
+// run itself starts again from the start state: the pilots only choose ε, which is then fixed for
+// the whole run (the map stays reversible and the run deterministic).
 #pragma once
 
 #include <algorithm>
@@ -40,6 +40,7 @@ struct ReversibleCalibration {
   double observed_ratio = 0.0;    ///< d₁/d₂ (2^p in the asymptotic regime) [-]
   double observed_order = 0.0;    ///< the order ε was extrapolated with [-]
   bool at_round_off = false;      ///< the pilots agreed to round-off: ε is the largest allowed
+  double largest_safe_step = 0.0;  ///< ε_a of the pilots that ran through [rad]
 };
 
 template <class Stepper, class System>
@@ -49,7 +50,7 @@ class ReversibleCartStepperAdapter final : public CartStepper {
   using Control = ReversibleStepControl<Stepper, System, Carried>;
 
  public:
-  static constexpr double kMaxFictiveStep = 0.05;   ///< ε_max [rad]: at 0.08–0.3 the gauss4 whirl's energy drifted
+  static constexpr double kMaxFictiveStep = 0.025;  ///< ε_max [rad]: above it the whirl's energy error wanders (7× at 0.05 over 1e4 s)
   static constexpr double kMinFictiveStep = 1e-6;   ///< ε_min [rad]: a tolerance below reach
   static constexpr double kPilotWindow = 60.0;      ///< longest pilot window [s]
   static constexpr int kMaxPilotAttempts = 8;       ///< halvings of ε_a after failed steps before giving up
@@ -182,6 +183,7 @@ class ReversibleCartStepperAdapter final : public CartStepper {
       const double d2 = (middle - fine).norm();
       const double noise = 1e-13 * (1.0 + fine.norm());  // [m]
       found.pilot_fictive_step = epsilon / 4.0;
+      found.largest_safe_step = epsilon;
       found.observed_ratio = d1 / d2;
       if (d1 <= noise && d2 <= noise) {  // already at round-off at the largest ε tried
         found.at_round_off = true;
@@ -205,7 +207,9 @@ class ReversibleCartStepperAdapter final : public CartStepper {
       }
       epsilon /= 2.0;
     }
-    found.fictive_step = std::min(found.fictive_step, kMaxFictiveStep);
+    // Never above ε_max, nor above the coarsest pilot that ran through the window (a coarser ε let
+    // ρ turn negative there: σ fell by more than ρ in one half-step).
+    found.fictive_step = std::min({found.fictive_step, kMaxFictiveStep, found.largest_safe_step});
     if (!(found.fictive_step >= kMinFictiveStep)) {
       std::ostringstream message;
       message << "tolerance " << settings_.tolerance << " m is out of reach for " << name_ << " (it would need ε = "

@@ -1,21 +1,22 @@
 // Reversible adaptive step size for the symmetric Birkhoffian members (docs/birkhoffian.md §11,
 // eqs. (B.41)–(B.44)): Hairer & Söderlind's explicit, time-reversible step-size control (SIAM J. Sci.
-// Comput. 26 (2005) 1838–1851; GNI §VIII.3.2), written for r = log ρ so that ρ stays positive.
-// With a step density σ(z, t) > 0 [1/s] (how fast the motion turns; the system's monitor, at least
-// σ₀), the step is h = ε/ρ where the control variable ρ = eʳ follows σ along the solution:
+// Comput. 26 (2005) 1838–1851; GNI §VIII.3.2). With a step density σ(z, t) > 0 [1/s] (how fast the
+// motion turns; the system's monitor, at least σ₀), the step is h = ε/ρ where the control variable
+// ρ follows σ along the solution:
 //
-//   rₙ₊½ = rₙ + (ε/2) Γ(zₙ, tₙ)                                                          (B.41)
-//   hₙ = min(ε e^{−rₙ₊½}, h_max),   (zₙ₊₁, yₙ₊₁) = Φ_{hₙ}(zₙ, yₙ),   tₙ₊₁ = tₙ + hₙ        (B.42)
-//   rₙ₊₁ = rₙ₊½ + (ε/2) Γ(zₙ₊₁, tₙ₊₁),    Γ = σ̇ / σ² = (∂σ/∂w · ẇ + ∂σ/∂t) / σ²          (B.43)
+//   ρₙ₊½ = ρₙ + (ε/2) G(zₙ, tₙ)                                                          (B.41)
+//   hₙ = min(ε/ρₙ₊½, h_max),   (zₙ₊₁, yₙ₊₁) = Φ_{hₙ}(zₙ, yₙ),   tₙ₊₁ = tₙ + hₙ             (B.42)
+//   ρₙ₊₁ = ρₙ₊½ + (ε/2) G(zₙ₊₁, tₙ₊₁),    G = σ̇/σ = (∂σ/∂w · ẇ + ∂σ/∂t) / σ              (B.43)
 //
-// In the fictive time τ (dt/dτ = 1/ρ) log σ changes at the rate σ̇/ρ, which is Γ where ρ = σ; the
-// two half-updates of r are a trapezoidal rule in τ. Hairer–Söderlind update ρ itself by εσ̇/σ,
-// which can drive ρ negative where σ falls fast (it did on the stiff_hinge scene at ε = 0.25);
-// r = log ρ cannot. Φ is one step of a symmetric member (Gauss collocation or a symmetric
-// composition), so the map (rₙ, zₙ, yₙ, tₙ) ↦ (rₙ₊₁, zₙ₊₁, yₙ₊₁, tₙ₊₁) is symmetric: the same map
-// with −ε undoes it (each half-update of r uses the state at its own end, and h depends on rₙ₊½
-// alone). ε [rad] is the fictive-time step: the angle the motion turns in one step. Reversibility
-// holds for any σ; σ only decides where the steps go.
+// In the fictive time τ (dt/dτ = 1/ρ), dρ/dτ = G makes d(ρ/σ)/dt = 0: ρ keeps its ratio to σ (the
+// two half-updates are a trapezoidal rule in τ). A first version updated log ρ by εσ̇/σ² so that ρ
+// could not turn negative; that makes ρ/σ unstable (d log(ρ/σ)/dt = (σ̇/σ)(ρ/σ − 1)) and on the
+// stiff_hinge scene the steps shrank without end. Here ρ ≤ 0 is a StepError that names it (a smaller
+// ε, i.e. a tighter tolerance, keeps ρ > 0). Φ is one step of a symmetric member (Gauss collocation
+// or a symmetric composition), so the map (ρₙ, zₙ, yₙ, tₙ) ↦ (ρₙ₊₁, zₙ₊₁, yₙ₊₁, tₙ₊₁) is symmetric:
+// the same map with −ε undoes it (each half-update of ρ uses the state at its own end, and h
+// depends on ρₙ₊½ alone). ε [rad] is the fictive-time step: the angle the motion turns in one step.
+// Reversibility holds for any σ; σ only decides where the steps go.
 //
 // G needs the derivative of σ along the flow: one evaluation of ẇ and one of σ on dual numbers
 // (forward-mode AD along ẇ), once per step (the G at the end of a step is the next step's first).
@@ -64,7 +65,7 @@ class ReversibleStepControl {
 
   const ReversibleStepSettings& settings() const { return settings_; }
   double time() const { return time_ + time_low_; }  ///< grid time tₙ [s]
-  double control() const { return std::exp(log_rho_); }  ///< ρₙ [1/s]
+  double control() const { return rho_; }  ///< ρₙ [1/s]
   Carried& grid() { return grid_; }
   const Carried& grid() const { return grid_; }
 
@@ -82,18 +83,18 @@ class ReversibleStepControl {
     system.begin_step(t);
     double derivative = 0.0;
     const double sigma = step_density(system, t, derivative, statistics);
-    log_rho_ = std::log(sigma);
-    gamma_ = derivative / (sigma * sigma);
+    rho_ = sigma;
+    log_rate_ = derivative / sigma;
   }
 
   /// The step the grid would take next with fictive step `epsilon` (±ε) [s].
-  double next_step(double epsilon) const { return step_for(epsilon, log_rho_ + 0.5 * epsilon * gamma_); }
+  double next_step(double epsilon) const { return step_for(epsilon, rho_ + 0.5 * epsilon * log_rate_); }
 
   /// One grid step (B.41)–(B.43) with fictive step ±ε (−ε undoes +ε). Returns h [s]. Throws StepError.
   double grid_step(System& system, double epsilon, StepStatistics& statistics) {
-    const double log_rho_half = log_rho_ + 0.5 * epsilon * gamma_;
-    if (!std::isfinite(log_rho_half)) fail("met a non-finite step-size control variable log ρ", log_rho_half);
-    const double h = step_for(epsilon, log_rho_half);
+    const double rho_half = rho_ + 0.5 * epsilon * log_rate_;
+    if (!(rho_half > 0.0) || !std::isfinite(rho_half)) fail("the step-size control variable ρ left (0, ∞)", rho_half);
+    const double h = step_for(epsilon, rho_half);
     const double t = time();
     system.begin_step(t);
     stepper_.advance_compensated(system, grid_.point, grid_.memory, t, h, statistics);
@@ -103,8 +104,8 @@ class ReversibleStepControl {
     renormalize_time();
     double derivative = 0.0;
     const double sigma = step_density(system, time(), derivative, statistics);
-    gamma_ = derivative / (sigma * sigma);
-    log_rho_ = log_rho_half + 0.5 * epsilon * gamma_;
+    log_rate_ = derivative / sigma;
+    rho_ = rho_half + 0.5 * epsilon * log_rate_;
     ++statistics.internal_steps;
     const double size = std::abs(h);
     statistics.internal_step_min = std::min(statistics.internal_step_min, size);
@@ -135,9 +136,9 @@ class ReversibleStepControl {
   }
 
  private:
-  /// hₙ = ±min(|ε| e^{−rₙ₊½}, h_max): a function of rₙ₊½ alone, so −ε retraces +ε (B.42).
-  double step_for(double epsilon, double log_rho_half) const {
-    return std::copysign(std::min(std::abs(epsilon) * std::exp(-log_rho_half), settings_.max_step), epsilon);
+  /// hₙ = ±min(|ε|/ρₙ₊½, h_max): a function of ρₙ₊½ alone, so −ε retraces +ε (B.42).
+  double step_for(double epsilon, double rho_half) const {
+    return std::copysign(std::min(std::abs(epsilon) / rho_half, settings_.max_step), epsilon);
   }
 
   void renormalize_time() {
@@ -199,8 +200,8 @@ class ReversibleStepControl {
   double time_ = 0.0;      ///< tₙ, high part [s]
   double time_low_ = 0.0;  ///< tₙ, low part [s]
   double time_low_add_ = 0.0;
-  double log_rho_ = 0.0;  ///< rₙ = log(ρₙ · 1 s) [-]
-  double gamma_ = 0.0;    ///< Γ(zₙ, tₙ) = σ̇/σ² [-]
+  double rho_ = 1.0;       ///< ρₙ [1/s]
+  double log_rate_ = 0.0;  ///< G(zₙ, tₙ) = σ̇/σ [1/s]
 };
 
 }  // namespace birkhoff_cart
