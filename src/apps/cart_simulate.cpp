@@ -151,6 +151,11 @@ void apply_overrides(const std::map<std::string, std::string>& arguments, Scene&
       if (text != "fixed" && text != "reversible") {
         throw UsageError("option --step-control must be 'fixed' or 'reversible', got '" + text + "'");
       }
+      // The scene's `tolerance` is dopri5's (1e-10 in the shipped scenes); as a position error in
+      // metres it would ask for ~1e7 internal steps: a tolerance must be given with the control.
+      if (text == "reversible" && scene.integrator.step_control != "reversible" && !arguments.count("--tolerance")) {
+        throw UsageError("option --step-control reversible needs --tolerance TOL (the position error [m] allowed)");
+      }
       scene.integrator.step_control = text;
     }
     if (option == "--on-accuracy-error" && text != "fail" && text != "warn") {

@@ -14,14 +14,31 @@ std::string local_error_estimate_summary(const StepStatistics& statistics, const
   return text;
 }
 
+std::string step_control_summary(const IntegratorSettings& settings, const StepStatistics& statistics) {
+  if (settings.step_control != "reversible") return "";
+  char text[320];
+  if (statistics.internal_steps == 0) {
+    std::snprintf(text, sizeof text, "reversible step control: tolerance %.3g m (no internal step yet)", settings.tolerance);
+  } else {
+    std::snprintf(text, sizeof text,
+                  "reversible step control: tolerance %.3g m, eps = %.4g rad (pilot order %.2g), %llu internal steps "
+                  "from %.3g s to %.3g s",
+                  settings.tolerance, statistics.control_fictive_step, statistics.control_observed_order,
+                  static_cast<unsigned long long>(statistics.internal_steps), statistics.internal_step_min,
+                  statistics.internal_step_max);
+  }
+  return text;
+}
+
 std::string run_summary(const Simulation& simulation, const AccuracyGuard& guard) {
   const StepStatistics& statistics = simulation.statistics();
   const Diagnostics diagnostics = simulation.diagnostics();
   char line[512];
   std::string text;
   std::snprintf(line, sizeof line,
-                "summary: scene '%s', integrator %s, h = %g s, t = %.9g s, %llu steps, %llu rhs evaluations\n",
-                simulation.scene().name.c_str(), simulation.integrator_name().c_str(), simulation.step_size(),
+                "summary: scene '%s', integrator %s, %s = %g s, t = %.9g s, %llu steps, %llu rhs evaluations\n",
+                simulation.scene().name.c_str(), simulation.integrator_name().c_str(),
+                simulation.scene().integrator.step_control == "reversible" ? "output step" : "h", simulation.step_size(),
                 simulation.state().time, static_cast<unsigned long long>(statistics.steps),
                 static_cast<unsigned long long>(statistics.rhs_evaluations));
   text += line;
@@ -32,15 +49,8 @@ std::string run_summary(const Simulation& simulation, const AccuracyGuard& guard
                 diagnostics.p2_balance_residual, diagnostics.max_constraint_residual);
   text += line;
   text += "  " + local_error_estimate_summary(statistics, simulation.integrator_name()) + "\n";
-  if (statistics.internal_steps > 0) {
-    std::snprintf(line, sizeof line,
-                  "  reversible step control: tolerance %.3g m, eps = %.4g rad (pilot order %.2g), %llu internal steps "
-                  "from %.3g s to %.3g s\n",
-                  simulation.scene().integrator.tolerance, statistics.control_fictive_step,
-                  statistics.control_observed_order, static_cast<unsigned long long>(statistics.internal_steps),
-                  statistics.internal_step_min, statistics.internal_step_max);
-    text += line;
-  }
+  const std::string control = step_control_summary(simulation.scene().integrator, statistics);
+  if (!control.empty()) text += "  " + control + "\n";
   text += "  accuracy: " + guard.summary() + "\n";
   return text;
 }

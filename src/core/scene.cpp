@@ -100,7 +100,7 @@ CartState read_initial_state(const SceneReader& reader, const YAML::Node& node) 
 IntegratorSettings read_integrator(const SceneReader& reader, const YAML::Node& node, const std::string& key) {
   reader.require_map(node, key,
                      {"name", "step_size", "tolerance", "birkhoffian_form", "max_newton_iterations",
-                      "newton_tolerance", "compensated_summation", "local_error_estimate", "step_control", "max_step",
+                      "newton_tolerance", "compensated_summation", "local_error_estimate", "step_control",
                       "tolerance_horizon"});
   IntegratorSettings settings;
   settings.name = reader.choice(node, key, "name", known_integrators());
@@ -120,7 +120,6 @@ IntegratorSettings read_integrator(const SceneReader& reader, const YAML::Node& 
   if (reader.has(node, "step_control")) {
     settings.step_control = reader.choice(node, key, "step_control", {"fixed", "reversible"});
   }
-  settings.max_step = reader.optional_number(node, key, "max_step", Range::kPositive, settings.max_step);
   settings.tolerance_horizon =
       reader.optional_number(node, key, "tolerance_horizon", Range::kPositive, settings.tolerance_horizon);
   if (settings.step_control == "reversible") {
@@ -131,9 +130,8 @@ IntegratorSettings read_integrator(const SceneReader& reader, const YAML::Node& 
       reader.fail(key + ".step_control", "'reversible' is for the symmetric Birkhoffian members (" + list + "), not '" +
                                              settings.name + "'");
     }
-  } else if (reader.has(node, "max_step") || reader.has(node, "tolerance_horizon")) {
-    reader.fail(key + (reader.has(node, "max_step") ? ".max_step" : ".tolerance_horizon"),
-                "is only for 'step_control: reversible'");
+  } else if (reader.has(node, "tolerance_horizon")) {
+    reader.fail(key + ".tolerance_horizon", "is only for 'step_control: reversible'");
   }
   return settings;
 }

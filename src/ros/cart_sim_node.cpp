@@ -187,10 +187,15 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
 
   paused_ = parameters_.start_paused;
   restart_schedule();
-  ROS_INFO("cart_sim: scene '%s' (%s), integrator %s, h = %g s, %s mode%s, publish %g Hz, end t = %s s, frames %s -> "
+  const std::string step_control = simulation_->scene().integrator.step_control == "reversible"
+                                       ? " (reversible step control for " +
+                                             format_seconds(simulation_->scene().integrator.tolerance) +
+                                             " m; h is the output step)"
+                                       : "";
+  ROS_INFO("cart_sim: scene '%s' (%s), integrator %s, h = %g s%s, %s mode%s, publish %g Hz, end t = %s s, frames %s -> "
            "%s, %s%s%s",
            simulation_->scene().name.c_str(), parameters_.scene_path.c_str(), simulation_->integrator_name().c_str(),
-           simulation_->step_size(), parameters_.fast ? "fast" : "real-time", parameters_.lockstep ? ", lockstep" : "",
+           simulation_->step_size(), step_control.c_str(), parameters_.fast ? "fast" : "real-time", parameters_.lockstep ? ", lockstep" : "",
            parameters_.publish_rate, format_seconds(end_time_).c_str(), parameters_.frames.odom.c_str(),
            parameters_.frames.base_link.c_str(),
            parameters_.publish_clock ? "publishing /clock"

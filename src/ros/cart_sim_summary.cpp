@@ -1,5 +1,7 @@
 // cart_sim's reports: /diagnostics and the final summary (see cart_sim_node.h).
 #include "birkhoff_cart/ros/cart_sim_node.h"
+
+#include "birkhoff_cart/core/run_summary.h"
 #include "birkhoff_cart/ros/accuracy_reporting.h"
 
 #include <algorithm>
@@ -127,6 +129,8 @@ void CartSimNode::write_summary(const std::string& outcome) {
        << " s), real-time factor " << real_time_factor(now)
        << ". Published instants: " << published_instants_ << "."
        << ros_accuracy::summary_sentence(accuracy_guard_, simulation_->statistics(), simulation_->integrator_name());
+  const std::string control = step_control_summary(simulation_->scene().integrator, simulation_->statistics());
+  if (!control.empty()) text << " Step size: the output step h; " << control << ".";
   if (parameters_.lockstep) text << " Lockstep timeouts: " << lockstep_timeouts_ << ".";
   if (recorder_) {
     text << " Bag: " << recorder_->current_path() << (record_failure_ ? " (unfinished; " : " (");

@@ -2,7 +2,8 @@
 // scenes — masses, inertias and geometry over physical ranges (log-uniform), initial steering
 // angles on, through and near χ = kπ, steering/drive torques and drag on or off, a few of the
 // paper's singular special case — each run with every integrator in integrator_names() (so new
-// members are covered the day they are registered). Every run must end in one of three loud ways:
+// members are covered the day they are registered), and every 10th with birkhoff2 and
+// birkhoff_gauss4 under the reversible step control. Every run must end in one of three loud ways:
 //   finished  — every state at the output instants finite (what the CSV and ~integration_error
 //               would carry: the state, its diagnostics, the local error estimate when there is
 //               one), and the accuracy guard's verdict (OK / WARN / ERROR naming the quantity);
@@ -31,6 +32,7 @@ namespace {
 constexpr int kSceneCount = 1000;
 constexpr std::uint64_t kSeed = 20261123;
 constexpr int kStepsBetweenChecks = 10;  // the guard and the finiteness checks, as at output instants
+constexpr int kReversibleEvery = 10;     // the reversible-control variants run on every 10th scene
 
 class RandomScenes {
  public:
@@ -148,6 +150,15 @@ std::string cause_of(const std::string& message) {
   return "other";
 }
 
+/// Every registered integrator at the scene's fixed step, and two symmetric members under the
+/// reversible step control ("NAME reversible TOL [m]", docs/birkhoffian.md §11).
+std::vector<std::string> run_variants() {
+  std::vector<std::string> variants = integrator_names();
+  variants.push_back("birkhoff2 reversible 1e-4");
+  variants.push_back("birkhoff_gauss4 reversible 1e-7");
+  return variants;
+}
+
 struct Tally {
   int ok = 0, warn = 0, guard_error = 0, step_error = 0;
 };
@@ -169,9 +180,15 @@ TEST(RandomHardCases, EveryIntegratorEndsFiniteWithAVerdictOrStopsWithANamedStep
       continue;
     }
     ++scenes;
-    for (const std::string& integrator : integrator_names()) {
+    for (const std::string& integrator : run_variants()) {
+      const bool reversible = integrator.find(" reversible") != std::string::npos;
+      if (reversible && scenes % kReversibleEvery != 0) continue;  // pilots make these runs dearer
       Scene run = scene;
-      run.integrator.name = integrator;
+      run.integrator.name = integrator.substr(0, integrator.find(' '));
+      if (reversible) {  // "NAME reversible TOL"
+        run.integrator.step_control = "reversible";
+        run.integrator.tolerance = std::stod(integrator.substr(integrator.rfind(' ') + 1));
+      }
       Simulation simulation(run);
       AccuracyGuard guard(run.accuracy);
       guard.check(simulation.state().time, simulation.diagnostics(), simulation.statistics());
@@ -214,13 +231,16 @@ TEST(RandomHardCases, EveryIntegratorEndsFiniteWithAVerdictOrStopsWithANamedStep
       }
     }
   }
-  std::printf("%d random scenes (%d draws rejected as invalid carts), %zu integrators:\n", scenes, rejected,
-              integrator_names().size());
-  std::printf("  %-10s %6s %6s %12s %10s\n", "integrator", "OK", "WARN", "guard ERROR", "StepError");
+  std::printf("%d random scenes (%d draws rejected as invalid carts), %zu integrators and controls:\n", scenes,
+              rejected, run_variants().size());
+  std::printf("  %-30s %6s %6s %12s %10s\n", "integrator", "OK", "WARN", "guard ERROR", "StepError");
   for (const auto& [integrator, tally] : tallies) {
-    std::printf("  %-10s %6d %6d %12d %10d\n", integrator.c_str(), tally.ok, tally.warn, tally.guard_error,
+    std::printf("  %-30s %6d %6d %12d %10d\n", integrator.c_str(), tally.ok, tally.warn, tally.guard_error,
                 tally.step_error);
-    EXPECT_EQ(tally.ok + tally.warn + tally.guard_error + tally.step_error, scenes) << integrator;
+    const bool reversible = integrator.find(" reversible") != std::string::npos;
+    EXPECT_EQ(tally.ok + tally.warn + tally.guard_error + tally.step_error,
+              reversible ? scenes / kReversibleEvery : scenes)
+        << integrator;
   }
   for (const auto& [quantity, count] : guard_quantities) std::printf("  guard ERROR on %s: %d\n", quantity.c_str(), count);
   for (const auto& [cause, count] : step_error_causes) std::printf("  StepError %s: %d\n", cause.c_str(), count);

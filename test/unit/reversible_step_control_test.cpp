@@ -5,7 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <fstream>
+#include <memory>
 #include <string>
 
 #include "birkhoff_cart/core/cart_birkhoffian.h"
@@ -35,6 +38,28 @@ struct Grid {
   using System = CartAutonomousBirkhoffian;
   using Carried = CarriedCartState<System, typename Stepper::template Memory<System>>;
   using Control = ReversibleStepControl<Stepper, System, Carried>;
+};
+
+/// birkhoff_gauss4's grid on the free whirl, started at its initial state with fictive step ε
+/// (and optionally a work limit): the setting of most tests below.
+struct WhirlGrid {
+  using G = Grid<GaussCollocation<2>>;
+  Scene scene = whirl();
+  CartModel model{scene.cart};
+  EffectSet effects;
+  G::System system{model, effects};
+  G::Carried seed;
+  StepStatistics statistics;
+  std::unique_ptr<G::Control> control;
+
+  explicit WhirlGrid(double epsilon, std::uint64_t work_limit = 1000000) {
+    seed.start_from(system, scene.initial_state);
+    ReversibleStepSettings settings;
+    settings.fictive_step = epsilon;
+    settings.max_steps_per_advance = work_limit;
+    control = std::make_unique<G::Control>(GaussCollocation<2>(), settings);
+    control->start(system, seed, 0.0, statistics);
+  }
 };
 
 /// Largest |a − b| / max(1, |b|) over z and y of two carried points [-].
@@ -108,24 +133,17 @@ TEST(ReversibleStepControl, ForwardThenBackwardReturnsToTheStart) {
 
 TEST(ReversibleStepControl, StepsFollowTheStepDensity) {
   // h·σ(zₙ₊½) ≈ ε: the steps are short where the whirl turns fast (near the jackknife).
-  using G = Grid<GaussCollocation<2>>;
-  const Scene scene = whirl();
-  const CartModel model(scene.cart);
-  const EffectSet effects;
-  G::System system(model, effects);
-  G::Carried seed;
-  seed.start_from(system, scene.initial_state);
-  ReversibleStepSettings settings;
-  settings.fictive_step = 0.1;
-  G::Control control(GaussCollocation<2>(), settings);
-  StepStatistics statistics;
-  control.start(system, seed, 0.0, statistics);
+  WhirlGrid grid(0.1);
+  auto& system = grid.system;
+  auto& control = *grid.control;
+  auto& statistics = grid.statistics;
+  const double epsilon = 0.1;
   double worst = 0.0;
   for (int n = 0; n < 500; ++n) {
     const double rho_start = control.control();
-    const double h = control.grid_step(system, settings.fictive_step, statistics);
+    const double h = control.grid_step(system, epsilon, statistics);
     const double rho_mean = std::sqrt(rho_start * control.control());
-    worst = std::max(worst, std::abs(h * rho_mean / settings.fictive_step - 1.0));
+    worst = std::max(worst, std::abs(h * rho_mean / epsilon - 1.0));
   }
   EXPECT_LT(worst, 0.05);
   EXPECT_EQ(statistics.internal_steps, 500u);
@@ -186,23 +204,16 @@ TEST(ReversibleStepControl, EnergyStaysBoundedOverALongFreeRun) {
   // no larger than 1.2× that over the first tenth (no drift; the benchmark runs 10 000 s), at the
   // largest ε the tolerance ever chooses (kMaxFictiveStep = 0.025 rad). At 0.05 rad the error wandered between
   // 9e-6 and 6e-5 J over 10 000 s; at 0.025 it holds 4.9e-7 J in every tenth.
-  using G = Grid<GaussCollocation<2>>;
-  const Scene scene = whirl();
-  const CartModel model(scene.cart);
-  const EffectSet effects;
-  G::System system(model, effects);
-  G::Carried seed;
-  seed.start_from(system, scene.initial_state);
-  ReversibleStepSettings settings;
-  settings.fictive_step = 0.025;
-  G::Control control(GaussCollocation<2>(), settings);
-  StepStatistics statistics;
-  control.start(system, seed, 0.0, statistics);
-  const double energy_start = system.hamiltonian(Eigen::Matrix<double, 4, 1>(seed.point.z));
+  WhirlGrid grid(0.025);
+  auto& system = grid.system;
+  auto& control = *grid.control;
+  auto& statistics = grid.statistics;
+  const double epsilon = 0.025;
+  const double energy_start = system.hamiltonian(Eigen::Matrix<double, 4, 1>(grid.seed.point.z));
   const double horizon = 1000.0;
   double first = 0.0, last = 0.0;
   while (control.time() < horizon) {
-    control.grid_step(system, settings.fictive_step, statistics);
+    control.grid_step(system, epsilon, statistics);
     const auto& point = control.grid().point;
     const double error =
         std::abs(system.hamiltonian(Eigen::Matrix<double, 4, 1>(point.z + point.z_remainder)) - energy_start);
@@ -262,9 +273,9 @@ TEST(ReversibleStepControl, BadSettingsAreRefusedByName) {
   } catch (const SceneError& error) {
     EXPECT_NE(std::string(error.what()).find("integrator.step_control"), std::string::npos) << error.what();
   }
-  const std::string max_step = birkhoff_cart_test::replaced_once(text, "birkhoffian_form: autonomous",
-                                                                "birkhoffian_form: autonomous\n  max_step: 0.1");
-  EXPECT_THROW(parse_scene(max_step, "bad.yaml"), SceneError) << "max_step without reversible control";
+  const std::string horizon = birkhoff_cart_test::replaced_once(text, "birkhoffian_form: autonomous",
+                                                               "birkhoffian_form: autonomous\n  tolerance_horizon: 10");
+  EXPECT_THROW(parse_scene(horizon, "bad.yaml"), SceneError) << "tolerance_horizon without reversible control";
   Scene tight = reversible_whirl("birkhoff2", 1e-14, 4.0, 0.5);
   Simulation simulation(tight);
   const CartState before = simulation.state();
@@ -275,6 +286,46 @@ TEST(ReversibleStepControl, BadSettingsAreRefusedByName) {
     EXPECT_NE(std::string(error.what()).find("out of reach"), std::string::npos) << error.what();
   }
   EXPECT_EQ(simulation.state().x, before.x);
+}
+
+}  // namespace
+}  // namespace birkhoff_cart
+
+namespace birkhoff_cart {
+namespace {
+
+TEST(ReversibleStepControl, AWorkLimitStopsARunThatWouldTakeTooManySteps) {
+  WhirlGrid grid(0.01, 100);
+  auto& system = grid.system;
+  auto& control = *grid.control;
+  auto& statistics = grid.statistics;  // 4 s of the whirl need ~1000 steps at ε = 0.01
+  try {
+    control.advance_grid_to(system, 4.0, statistics);
+    FAIL() << "the work limit did not stop the run";
+  } catch (const StepError& error) {
+    EXPECT_NE(std::string(error.what()).find("more than 100 internal steps"), std::string::npos) << error.what();
+  }
+}
+
+TEST(ReversibleStepControl, TheCliAsksForATolerance) {
+  // The shipped scenes' tolerance (1e-10) is dopri5's; as metres it would mean ~1e7 steps.
+  const std::string csv = testing::TempDir() + "reversible_cli.csv";
+  const auto without = birkhoff_cart_test::run_cart_simulate(
+      "--scene " + scene_path("jackknife_whirl") + " --step-control reversible --quiet --output " + csv,
+      testing::TempDir() + "reversible_cli.err");
+  EXPECT_EQ(without.exit_status, 2);
+  EXPECT_NE(without.standard_error.find("needs --tolerance"), std::string::npos) << without.standard_error;
+  const std::string summary = testing::TempDir() + "reversible_cli.out";
+  const std::string command = "'" + birkhoff_cart_test::cart_simulate_path() + "' --scene " +
+                              scene_path("jackknife_whirl") +
+                              " --step-control reversible --tolerance 1e-5 --duration 1 --quiet --output " + csv + " > " +
+                              summary;
+  EXPECT_EQ(std::system(command.c_str()), 0);
+  const std::string text = birkhoff_cart_test::read_file(summary);
+  EXPECT_NE(text.find("reversible step control: tolerance 1e-05 m"), std::string::npos) << text;
+  EXPECT_NE(text.find("output step = "), std::string::npos) << text;
+  std::remove(summary.c_str());
+  std::remove(csv.c_str());
 }
 
 }  // namespace

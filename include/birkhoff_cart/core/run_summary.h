@@ -12,6 +12,10 @@ namespace birkhoff_cart {
 /// "local error estimate: last 1.2e-09, max 3.4e-09, sum 5.6e-06 [-]" or "... none (<integrator> has none)".
 std::string local_error_estimate_summary(const StepStatistics& statistics, const std::string& integrator);
 
+/// One line on the reversible step control (tolerance, ε, internal steps and their range); empty for
+/// step_control "fixed".
+std::string step_control_summary(const IntegratorSettings& settings, const StepStatistics& statistics);
+
 /// Several lines, each ending in '\n', each starting with two spaces except the first.
 std::string run_summary(const Simulation& simulation, const AccuracyGuard& guard);
 

@@ -77,7 +77,6 @@ struct IntegratorSettings {
   /// chosen by the reversible controller (docs/birkhoffian.md §11) for `tolerance` as the position
   /// error [m] the run may reach by `tolerance_horizon`; step_size is then only the output step.
   std::string step_control = "fixed";
-  double max_step = std::numeric_limits<double>::infinity();  ///< reversible: the longest internal step [s]
   double tolerance_horizon = 0.0;   ///< reversible: the time the tolerance is for [s]; 0: the scene's duration
 };
 

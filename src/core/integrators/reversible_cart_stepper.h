@@ -53,7 +53,7 @@ class ReversibleCartStepperAdapter final : public CartStepper {
   static constexpr double kMaxFictiveStep = 0.025;  ///< ε_max [rad]: above it the whirl's energy error wanders (7× at 0.05 over 1e4 s)
   static constexpr double kMinFictiveStep = 1e-6;   ///< ε_min [rad]: a tolerance below reach
   static constexpr double kPilotWindow = 60.0;      ///< longest pilot window [s]
-  static constexpr int kMaxPilotAttempts = 8;       ///< halvings of ε_a after failed steps before giving up
+  static constexpr int kMaxPilotAttempts = 4;       ///< halvings of ε_a after failed steps before giving up (each doubles the cost)
   static constexpr int kPilotAttemptsForOrder = 2;  ///< halvings of ε_a waiting for the order p
 
   ReversibleCartStepperAdapter(const Stepper& stepper, const IntegratorSettings& settings, const CartModel& model,
@@ -63,7 +63,6 @@ class ReversibleCartStepperAdapter final : public CartStepper {
       throw std::invalid_argument("step_control 'reversible' needs a finite tolerance > 0 m, got " +
                                   std::to_string(settings.tolerance));
     }
-    if (!(settings.max_step > 0.0)) throw std::invalid_argument("integrator.max_step must be > 0 s");
     if (!(settings.tolerance_horizon > 0.0) || !std::isfinite(settings.tolerance_horizon)) {
       throw std::invalid_argument("integrator.tolerance_horizon must be finite and > 0 s");
     }
@@ -110,7 +109,6 @@ class ReversibleCartStepperAdapter final : public CartStepper {
     seed.start_from(system_, state);
     ReversibleStepSettings control_settings;
     control_settings.fictive_step = calibration_->fictive_step;
-    control_settings.max_step = settings_.max_step;
     control_ = std::make_unique<Control>(stepper_, control_settings);
     control_->start(system_, seed, state.time, statistics);
   }
@@ -133,7 +131,6 @@ class ReversibleCartStepperAdapter final : public CartStepper {
     seed.start_from(system_, state);
     ReversibleStepSettings control_settings;
     control_settings.fictive_step = epsilon;
-    control_settings.max_step = settings_.max_step;
     Control control(stepper_, control_settings);
     control.start(system_, seed, state.time, statistics);
     const double end = state.time + window;
@@ -212,7 +209,7 @@ class ReversibleCartStepperAdapter final : public CartStepper {
     found.fictive_step = std::min({found.fictive_step, kMaxFictiveStep, found.largest_safe_step});
     if (!(found.fictive_step >= kMinFictiveStep)) {
       std::ostringstream message;
-      message << "tolerance " << settings_.tolerance << " m is out of reach for " << name_ << " (it would need ε = "
+      message << "tolerance " << settings_.tolerance << " m is out of reach for " << name_ << " (it would need eps = "
               << found.fictive_step << " rad < " << kMinFictiveStep << "): use a higher-order member or a looser tolerance";
       throw StepError(message.str());
     }
