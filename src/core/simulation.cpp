@@ -48,6 +48,7 @@ Simulation::Simulation(const Scene& scene)
       stepper_(make_cart_stepper(integrator_settings(scene), model_, effects_)),
       state_(scene.initial_state),
       schedule_(plan_steps(scene.initial_state.time, scene.duration, scene.integrator.step_size)) {
+  stepper_->prepare(state_, statistics_);  // the reversible control's pilots; refuses an unreachable tolerance
   initial_energy_ = model_.energy(state_);
   initial_steering_momentum_ = model_.steering_momentum(state_);
   reference_ = make_reference_solution(scene_, model_, effects_);
@@ -114,6 +115,7 @@ void Simulation::reset() {
   steps_taken_ = 0;
   finished_off_grid_ = false;
   statistics_ = StepStatistics{};
+  stepper_->prepare(state_, statistics_);
   if (reference_) reference_->reset();
   if (effects_.steering_command()) effects_.steering_command()->value = initial_command(scene_, "steering_torque");
   if (effects_.drive_command()) effects_.drive_command()->value = initial_command(scene_, "drive_torque");

@@ -73,6 +73,21 @@ class ReversibleCartStepperAdapter final : public CartStepper {
   bool symmetric() const override { return true; }
   const std::optional<ReversibleCalibration>& calibration() const { return calibration_; }
 
+  /// The pilot runs (ε for the tolerance) from `start`; a tolerance out of reach is a settings
+  /// error (std::invalid_argument), not a failed step.
+  void prepare(const CartState& start, StepStatistics& statistics) override {
+    if (calibration_) return;
+    StepStatistics counted = statistics;
+    try {
+      calibrate(start, counted);
+    } catch (const StepError& error) {
+      throw std::invalid_argument(name_ + " (reversible step control): " + error.what());
+    }
+    counted.control_fictive_step = calibration_->fictive_step;
+    counted.control_observed_order = calibration_->observed_order;
+    statistics = counted;
+  }
+
   void step(CartState& state, double step_size, StepStatistics& statistics) override {
     stepper_checks::require_valid_step_size(step_size);
     const double time = state.time;  // tₖ [s]

@@ -32,6 +32,11 @@ class CartStepper {
   /// Advances `state` (time included) by h [s]; adds its work to `statistics`. Throws StepError
   /// and leaves `state` untouched on failure.
   virtual void step(CartState& state, double step_size, StepStatistics& statistics) = 0;
+  /// Work done once before the first step from `start`, adding to `statistics` (the reversible step
+  /// control's pilot runs; nothing for the others). Throws std::invalid_argument when the settings
+  /// cannot work from this start (a tolerance out of the member's reach), so that a caller refuses
+  /// the scene at load instead of failing its first step.
+  virtual void prepare(const CartState& /*start*/, StepStatistics& /*statistics*/) {}
 };
 
 /// Registered names: birkhoff2, birkhoff4, rk2, rk4, dopri5, midpoint, birkhoff_gauss4, birkhoff_gauss6,
