@@ -2,7 +2,7 @@
 # Set up, build, run every gtest and rostest of birkhoff_cart, and print one closing line
 # "N passed, N failed" (gtest and rostest cases together). Exits non-zero when anything failed, was
 # skipped or did not run: test/expected_results.txt lists every result file and its minimum number
-# of cases (scripts/count_test_results.py). `catkin_make run_tests` exits 0 on failures, so the result XML decides.
+# of cases (checks/count_test_results.py). `catkin_make run_tests` exits 0 on failures, so the result XML decides.
 set -uo pipefail
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 # Debian's python3 (with the ROS modules) must win over the pyenv interpreter on PATH: catkin,
@@ -35,7 +35,7 @@ echo "== catkin_test_results"
 catkin_test_results --verbose "$workspace/build/test_results" | tail -n 40
 results_status=${PIPESTATUS[0]}
 
-/usr/bin/python3 "$repo/scripts/count_test_results.py" "$results" \
+/usr/bin/python3 "$repo/checks/count_test_results.py" "$results" \
   --manifest "$repo/test/expected_results.txt" --sources "$repo"
 count_status=$?
 

@@ -1,4 +1,4 @@
-// Fuzz target for the scene reader (scripts/fuzz_scenes.sh builds and runs it; docs/accuracy.md §3).
+// Fuzz target for the scene reader (checks/fuzz_scenes.sh builds and runs it; docs/accuracy.md §3).
 //
 // One input = the bytes of a scene file. The contract under test: load_scene() either returns a
 // Scene or throws SceneError (a one-line message naming the file and the key); an accepted scene

@@ -34,7 +34,7 @@ constexpr double kAbsurdTorque = 1e300;                 // [N·m], finite
 constexpr int kFloodSteps = 10000;                      // 10 s at h = 1 ms
 constexpr int kCommandsPerStep = 10;                    // 10 kHz of commands against 1 kHz of steps
 #if defined(__SANITIZE_ADDRESS__)
-// Under AddressSanitizer (scripts/sanitize.sh) freed blocks wait in its quarantine (1 MiB there)
+// Under AddressSanitizer (checks/sanitize.sh) freed blocks wait in its quarantine (1 MiB there)
 // and new heap pages get shadow memory: measured 3808 kB of growth with no leak (ASan reports
 // none), so the allowance is 4 MiB on top of the plain limit.
 constexpr long kFloodMemoryGrowthLimit = 1024 + 4096;   // resident set growth [kB] over the flood

@@ -1,4 +1,4 @@
-// The install space works (issue 17): scripts/test_install.sh installs this built workspace into a
+// The install space works (issue 17): checks/test_install.sh installs this built workspace into a
 // temporary DESTDIR and runs cart_simulate, cart_sim --version, rospack, rosmsg and a 2 s
 // `roslaunch birkhoff_cart sim.launch` from there, in an environment without the devel space or
 // the source tree (about 15 s). Before the libraries had install rules, the installed
@@ -20,7 +20,7 @@ TEST(InstallSpace, RunsFromATemporaryPrefix) {
   const std::string workspace = binary_directory + "/../../..";
   const std::string log = ::testing::TempDir() + "install_space_test.log";
   const std::string command = "BIRKHOFF_CART_WORKSPACE='" + workspace + "' bash '" BIRKHOFF_CART_SOURCE_DIR
-                              "/scripts/test_install.sh' --no-build > '" + log + "' 2>&1";
+                              "/checks/test_install.sh' --no-build > '" + log + "' 2>&1";
   const int status = std::system(command.c_str());
   const std::string output = birkhoff_cart_test::read_file(log);
   std::printf("%s", output.c_str());

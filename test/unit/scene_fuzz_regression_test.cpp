@@ -1,4 +1,4 @@
-// Every finding of the scene-reader fuzzer (scripts/fuzz_scenes.sh) kept as a regression: each file
+// Every finding of the scene-reader fuzzer (checks/fuzz_scenes.sh) kept as a regression: each file
 // in test/fuzz/regressions/ must meet the fuzz target's contract (test/fuzz/scene_reader_fuzz.cpp):
 // load_scene() returns or throws a one-line SceneError; an accepted scene makes a Simulation or is
 // refused with std::invalid_argument; its first steps succeed with a finite state or throw

@@ -8,7 +8,7 @@
 
 #include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/effects.h"
-#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/effect_spec.h"
 
 namespace birkhoff_cart {
 

@@ -5,7 +5,7 @@
 #include <stdexcept>
 
 #include "birkhoff_cart/core/effects/torque_source.h"
-#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/torque_profile.h"
 
 namespace birkhoff_cart {
 

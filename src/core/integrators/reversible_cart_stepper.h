@@ -26,7 +26,7 @@
 #include "birkhoff_cart/core/integrators/carried_state.h"
 #include "birkhoff_cart/core/integrators/cart_stepper.h"
 #include "birkhoff_cart/core/integrators/reversible_step_control.h"
-#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/integrator_settings.h"
 #include "step_checks.h"
 
 namespace birkhoff_cart {

@@ -3,9 +3,10 @@
 
 #include <limits>
 #include <memory>
+#include <string>
 
 #include "birkhoff_cart/core/effects.h"
-#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/torque_profile.h"
 
 namespace birkhoff_cart {
 

@@ -9,7 +9,7 @@
 #include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/diagnostics.h"
 #include "birkhoff_cart/core/effects.h"
-#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/integrator_settings.h"
 #include "birkhoff_cart/core/state.h"
 
 namespace birkhoff_cart {

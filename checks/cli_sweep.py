@@ -12,7 +12,7 @@ below the floor) and Birkhoffian forms. Each run must end in one of:
 and never an abort, a crash, another exit status or a run past the time budget (BUDGET s).
 Prints the counts per outcome and per refusal reason, and "N passed, N failed"; exits 1 on a failure.
 
-Usage: scripts/cli_sweep.py [--runs 2000] [--seed 17] [--jobs 2] [--budget 120]
+Usage: checks/cli_sweep.py [--runs 2000] [--seed 17] [--jobs 2] [--budget 120]
                             [--binary .ws/devel/lib/birkhoff_cart/cart_simulate]
 """
 import argparse

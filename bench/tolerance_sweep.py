@@ -8,7 +8,7 @@ at a fixed step h_ref and at h_ref/2, which must agree to better than 1/10 of th
 judged (else that scene's verdicts at that tolerance are marked "ref?"). Prints, per scene and member,
 error/tolerance for each tolerance, the rhs evaluations, and a final count of runs within 10x.
 
-usage: /usr/bin/python3 scripts/tolerance_sweep.py [--simulate PATH] [--members birkhoff_gauss4,...]
+usage: /usr/bin/python3 bench/tolerance_sweep.py [--simulate PATH] [--members birkhoff_gauss4,...]
                                                    [--tolerances 1e-4,...] [--scenes a,b]
 """
 import argparse

@@ -10,13 +10,13 @@
 # stderr; the logs are also searched for a report. Every run first proves that on small programs
 # with one defect each (--self-check).
 #
-# One suppression, by name (scripts/sanitize/lsan.supp): the rosbag::Bag that BagRecorder::close()
+# One suppression, by name (checks/sanitize/lsan.supp): the rosbag::Bag that BagRecorder::close()
 # lets go on purpose when closing it failed (its destructor would throw; see bag_recorder.cpp).
 # bad_input_test's memory-growth check runs with a 1 MiB ASan quarantine (quarantine_size_mb=1):
 # with the default 256 MiB quarantine every freed block stays resident and the flood would look
 # like growth.
 #
-# Usage: scripts/sanitize.sh [--compiler gcc|clang] [--no-build] [--self-check]
+# Usage: checks/sanitize.sh [--compiler gcc|clang] [--no-build] [--self-check]
 #        (default gcc, the project's compiler; with clang the build stops at clang-only warnings,
 #        since the package builds with -Werror; --self-check only proves the report detection, 3 s)
 # Prints "N passed, N failed" and the wall and CPU time; exits non-zero on any failure or report.
@@ -91,7 +91,7 @@ logs="$workspace/logs"
 reports="$logs/reports"  # every sanitizer report of every process, children included
 rm -rf "$logs"
 mkdir -p "$reports"
-suppressions="$repo/scripts/sanitize/lsan.supp"
+suppressions="$repo/checks/sanitize/lsan.supp"
 common="abort_on_error=0:halt_on_error=1:detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1"
 export LSAN_OPTIONS="suppressions=$suppressions:print_suppressions=0"
 passed=0

@@ -9,7 +9,7 @@
 #      master and cart_sim ends with "finished".
 # About 30 s on a built workspace. Prints "N passed, N failed" and exits non-zero on a failure.
 #
-# Usage: scripts/test_install.sh [--no-build]
+# Usage: checks/test_install.sh [--no-build]
 #   BIRKHOFF_CART_WORKSPACE=/path/to/ws: use that built workspace instead of setting up .ws/;
 #   --no-build: install what is built, without `cmake --build` first (the gtest install_space_test
 #   runs it so, from inside `catkin_make run_tests`).
@@ -17,7 +17,7 @@ set -uo pipefail
 build=true
 if [ "${1:-}" = "--no-build" ]; then build=false; fi
 # shellcheck source=scripts/workspace.sh
-source "$(dirname "${BASH_SOURCE[0]}")/workspace.sh"  # → $repo, $workspace (set up and built)
+source "$(dirname "${BASH_SOURCE[0]}")/../scripts/workspace.sh"  # → $repo, $workspace (set up and built)
 
 # DESTDIR install: catkin writes the workspace files (setup.bash, .catkin, ...) to the configured
 # CMAKE_INSTALL_PREFIX, so the whole tree goes under a temporary DESTDIR instead; every catkin

@@ -12,7 +12,7 @@
 # steadier measure of cost; node/core = node's cost over cart_simulate's.
 # Starts its own roscore on a free port, stops only what it started, removes its scratch directory.
 #
-# Usage: scripts/bench_node_cost.sh [WORKSPACE]     (default .ws; must have cart_sim built)
+# Usage: bench/bench_node_cost.sh [WORKSPACE]     (default .ws; must have cart_sim built)
 set -euo pipefail
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 workspace="${1:-$repo/.ws}"

@@ -7,7 +7,7 @@
 # for the budget; without clang a mutation loop over the shipped scenes (the same target built with
 # g++ and -DSCENE_FUZZ_MUTATION_LOOP) runs instead.
 #
-# Usage: scripts/fuzz_scenes.sh [SECONDS (default 120)] [JOBS (default 1)]
+# Usage: checks/fuzz_scenes.sh [SECONDS (default 120)] [JOBS (default 1)]
 # Findings (crashes, sanitizer reports, hangs past 10 s, non-SceneError exceptions) are written to
 # $out/findings/ (out = .fuzz/ in the repository); the script exits 1 when there is one. Turn each
 # into a file under test/fuzz/regressions/ (scene_fuzz_regression_test runs them all).

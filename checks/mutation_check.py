@@ -3,7 +3,7 @@
 of the repository, builds only the test targets that should notice, runs those tests, and fails
 (exit status 1) if any mutation survives — i.e. if every one of its tests still passes.
 
-Usage: /usr/bin/python3 scripts/mutation_check.py [--scratch DIR] [--only NAME ...] [--list]
+Usage: /usr/bin/python3 checks/mutation_check.py [--scratch DIR] [--only NAME ...] [--list]
 
 The working tree is never modified: the tracked files are copied (git ls-files) to
 DIR/src/birkhoff_cart (default: $TMPDIR/birkhoff_cart_mutation), configured once with CMake

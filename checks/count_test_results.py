@@ -53,9 +53,9 @@ def expected_from_sources(repo: pathlib.Path):
 
 def write_manifest(results: pathlib.Path, manifest: pathlib.Path) -> int:
     lines = ["# Every result file a full run of scripts/run_tests.sh must leave, with its minimum number of",
-             "# test cases (scripts/count_test_results.py). A missing file, fewer cases, a skipped case or an",
+             "# test cases (checks/count_test_results.py). A missing file, fewer cases, a skipped case or an",
              "# unlisted file fails the run. Regenerate after adding tests, from a full passing run:",
-             "#   /usr/bin/python3 scripts/count_test_results.py .ws/build/test_results/birkhoff_cart \\",
+             "#   /usr/bin/python3 checks/count_test_results.py .ws/build/test_results/birkhoff_cart \\",
              "#       --write-manifest test/expected_results.txt"]
     for path in sorted(results.glob("**/*.xml")):
         cases = len(list(ElementTree.parse(path).getroot().iter("testcase")))
