@@ -62,7 +62,7 @@ const char* const kUsage =
     "  --scene FILE            scene YAML (config/scenes/*.yaml); it provides every default\n"
     "  --integrator NAME       birkhoff2, birkhoff4, birkhoff_gauss4, birkhoff_gauss6, birkhoff_gauss8,\n"
     "                          birkhoff4_suzuki, birkhoff6_kahan_li, birkhoff8_kahan_li, rk2, rk4, dopri5\n"
-    "                          or midpoint (docs/birkhoffian.md; README, \"The integrators\")\n"
+    "                          or midpoint (docs/integrators.md)\n"
     "  --step H                step size [s], > 0; 1/HZ must be a whole multiple of it\n"
     "  --tolerance TOL         dopri5: absolute and relative tolerance [-], >= 10 machine epsilon (2.2e-15);\n"
     "                          reversible step control: the position error [m] allowed at the horizon\n"
