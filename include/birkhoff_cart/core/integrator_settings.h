@@ -8,8 +8,8 @@ namespace birkhoff_cart {
 
 /// Integrator choice and its settings.
 struct IntegratorSettings {
-  std::string name = "birkhoff2";                 ///< a name from integrator_names()
-  double step_size = 1e-3;                        ///< h [s]
+  std::string name = "birkhoff_gauss4";           ///< a name from integrator_names(); the default scene's
+  double step_size = 0.01;                        ///< h [s], the default scene's
   double tolerance = 1e-10;                       ///< dopri5 absolute and relative tolerance [-]
   std::string birkhoffian_form = "autonomous";    ///< "autonomous" (z = (π1, χ, p1, p2), K = K₀) or "paper" (K = eᵗ J)
   int max_newton_iterations = 30;                 ///< per implicit step
