@@ -20,7 +20,7 @@
 #        (default gcc, the project's compiler; with clang the build stops at clang-only warnings,
 #        since the package builds with -Werror; --self-check only proves the report detection, 3 s)
 # Prints "N passed, N failed" and the wall and CPU time; exits non-zero on any failure or report.
-# Measured on the shared 2-core machine (README, "Sanitizers"): from scratch 41 min 39 s of wall time
+# Measured on the shared 2-core machine (docs/developing.md): from scratch 41 min 39 s of wall time
 # (1868 s CPU; the build ~29 min of it, niced beside other builds); with a warm ccache and few changed
 # files 16 min 9 s (build 155 s, the 45 runs 814 s, one at a time).
 set -uo pipefail

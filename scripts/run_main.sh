@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The main job (README): set up and build, then run the ROS simulator headless in fast mode on the
+# The main job (README.md, "The two commands"): set up and build, then run the ROS simulator headless in fast mode on the
 # default scene for 60 s of simulated time, recording a compressed bag, and print the bag's
 # `rosbag info`, the node's one-paragraph summary and a picture of the run drawn from the bag
 # (plot_bag: path, steering angle, speed, error diagnostics). Needs no display and no stdin;

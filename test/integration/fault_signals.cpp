@@ -163,7 +163,7 @@ TEST(FaultSignals, UnwritableBagPathStopsTheNodeWithAMessageNamingIt) {
 
 TEST(FaultSignals, SceneStartingAtNegativeTimeStopsTheNodeAtStartWithExit2) {
   // Scene time is published as ROS time, which cannot be negative: the node must refuse at start
-  // (exit 2, README "Exit codes"), not abort at its first /clock with the bag left unfinished.
+  // (exit 2, docs/ros_interface.md, "Node cart_sim"), not abort at its first /clock with the bag left unfinished.
   std::string scene = read_file(scene_parameter());
   const std::string start_line = "\n  time: 0.0";  // initial_state.time of driven.yaml
   const std::size_t at = scene.find(start_line);

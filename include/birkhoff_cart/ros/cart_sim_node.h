@@ -1,12 +1,12 @@
 // The ROS wrapper around a core Simulation (robot_localization style: the core knows nothing of
 // ROS; this class only translates). Every private parameter is read once in load_parameters() and
-// documented in README.md, "ROS interface" (meaning, unit, default).
+// documented in docs/ros_interface.md, "ROS interface" (meaning, unit, default).
 //
 // Time: the node steps the simulation and publishes /clock itself (run with /use_sim_time true);
 // message stamps are the scene's time t (scene time t is ROS time t). The first /clock is one step
 // after the start (t0 + h), never 0. A run with an end is cut into steps by the rule that
 // cart_simulate uses (step_schedule.h): whole steps on t0 + n h, then one landing step exactly on
-// t0 + T, which is published as the run's last instant. Three ways to run (README.md, "Running modes"):
+// t0 + T, which is published as the run's last instant. Three ways to run (docs/ros_interface.md, "Running modes"):
 //  - fast: as fast as possible (or at ~real_time_factor). Callbacks run at the first step after the
 //    transport queued them (SignalingCallbackQueue's flag, one atomic load per step).
 //  - real time: paced by absolute wall-clock deadlines (WallClockPacing); the node sleeps until the

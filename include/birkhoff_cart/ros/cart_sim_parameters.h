@@ -1,5 +1,5 @@
 // Every private parameter of cart_sim, read and validated in one place (robot_localization's
-// loadParams habit). Each is documented in README.md, "ROS interface" (meaning, unit, default).
+// loadParams habit). Each is documented in docs/ros_interface.md, "ROS interface" (meaning, unit, default).
 #pragma once
 
 #include <cstdint>
@@ -12,7 +12,7 @@
 
 namespace birkhoff_cart {
 
-/// Every private parameter of cart_sim, with its default (README.md, "ROS interface").
+/// Every private parameter of cart_sim, with its default (docs/ros_interface.md, "ROS interface").
 struct CartSimParameters {
   std::string scene_path;                    ///< ~scene: scene YAML (required)
   std::string integrator;                    ///< ~integrator: registry name; "" = the scene's

@@ -1,7 +1,7 @@
 // The control law of cmd_vel_controller, ROS-free so its rules are unit-tested without a master and
 // its closed loop with a core Simulation runs in a plain gtest.
 //
-// cmd_vel (v*, r*) → steering and drive torques (τ, T) of the cart (README.md, "Node
+// cmd_vel (v*, r*) → steering and drive torques (τ, T) of the cart (docs/ros_interface.md, "Node
 // cmd_vel_controller"). Kinematics of base_link (the rear-axle midpoint A, docs eq. (2.3)):
 //   v_A = ω1 cos χ,   θ̇ = ω1 sin χ / l   ⇒   θ̇ = v_A tan χ / l,
 // so the steering angle that turns at yaw rate r* at speed v* is  χ* = atan(r* l / v*)  (|χ*| < π/2,
@@ -27,7 +27,7 @@
 namespace birkhoff_cart {
 
 /// Every setting of the law, with its default (the node reads each from a private parameter of the
-/// same name, README.md). Limits follow ros_controllers' names (linear/x/..., angular/z/...).
+/// same name, docs/ros_interface.md). Limits follow ros_controllers' names (linear/x/..., angular/z/...).
 struct CmdVelControllerSettings {
   double wheel_separation_h = 1.05;      ///< l: base_link (A) to the steering hinge B [m]
   double cmd_vel_timeout = 0.5;          ///< silence after which the command is (0, 0) [s]; 0 = never

@@ -1,4 +1,4 @@
-// cmd_vel_controller: the ROS side of CmdVelController (README.md, "Node cmd_vel_controller").
+// cmd_vel_controller: the ROS side of CmdVelController (docs/ros_interface.md, "Node cmd_vel_controller").
 //
 // Subscribes cmd_vel (geometry_msgs/Twist: linear.x = v* of base_link [m/s], angular.z = r* [rad/s]),
 // odom (v_A = twist.linear.x) and joint_states (χ, χ̇ of ~steering_joint); publishes steering_torque

@@ -1,4 +1,4 @@
-// cart_sim: the simulator node (README.md, "ROS interface"). All the work is in CartSimNode.
+// cart_sim: the simulator node (docs/ros_interface.md, "ROS interface"). All the work is in CartSimNode.
 // Exit codes: 0 finished or interrupted, 1 step failure, 2 refused at start, 3 record failure,
 // 4 unexpected error (bag closed), 130 a second SIGINT/SIGTERM (bag left as <path>.active).
 #include <signal.h>
@@ -19,7 +19,7 @@
 
 namespace {
 
-// ~end_launch (README.md): a roslaunch that started this node with required="true" prints a red
+// ~end_launch (docs/ros_interface.md): a roslaunch that started this node with required="true" prints a red
 // "REQUIRED process has died!" block whenever the node ends, also after a clean finish. With
 // ~end_launch the node asks its parent roslaunch to shut down (SIGINT) and waits for roslaunch's
 // own SIGINT before it exits, so roslaunch is already shutting down and prints no error.

@@ -1,4 +1,4 @@
-// cmd_vel_controller: drives cart_sim from geometry_msgs/Twist on cmd_vel (README.md, "Node
+// cmd_vel_controller: drives cart_sim from geometry_msgs/Twist on cmd_vel (docs/ros_interface.md, "Node
 // cmd_vel_controller"). All the work is in CmdVelControllerNode and CmdVelController.
 // Exit codes: 0 shut down, 2 refused at start (bad parameter, name or remapping), 4 unexpected error.
 #include <ros/ros.h>

@@ -1,5 +1,5 @@
-// steering_pd_controller: an example controller for cart_sim's lockstep mode (README.md, "Lockstep
-// with controller nodes"). On every joint_states message (stamped t) it answers once with
+// steering_pd_controller: an example controller for cart_sim's lockstep mode (docs/ros_interface.md, "Node
+// steering_pd_controller"). On every joint_states message (stamped t) it answers once with
 //   steering_torque τ = kp (χ_ref(t) − χ) + kd (χ̇_ref(t) − χ̇),  χ_ref(t) = amplitude · sin(2π frequency t)
 // [N·m] (χ, χ̇: steering_joint's position [rad] and velocity [rad/s]) and drive_torque = ~drive_torque
 // [N·m]. It computes only from the message, so a lockstep loop is the same on every run.
