@@ -26,6 +26,8 @@ packages=(
   rosbash ros-robot-state-publisher liburdf-dev rviz xvfb
   libboost-dev libyaml-cpp-dev libeigen3-dev googletest libgtest-dev
   python3-matplotlib python3-numpy
+  # the study runner (scripts/study): Dask distributed, its local cluster and the row tables
+  python3-distributed python3-dask python3-pandas python3-yaml
 )
 missing=()
 for package in "${packages[@]}"; do

@@ -46,6 +46,7 @@
 #include "work_precision/output.h"
 #include "work_precision/paper_figures.h"
 #include "work_precision/reference.h"
+#include "work_precision/single_task.h"
 #include "work_precision/step_cost.h"
 
 namespace {
@@ -250,8 +251,15 @@ void run_scene(BenchScene& bench, const ReferenceSet* shared, const Options& opt
 
 const char* const kUsage =
     "usage: work_precision [--quick] [--repetitions N] [--output-dir DIR] [--scene-dir DIR] [--only PREFIX]\n"
+    "       work_precision --measure --scene FILE --duration T --method NAME (--step H | --tolerance TOL)\n"
+    "                      [--simulator-step S] [--checkpoints t1,t2,...] [--repetitions N] [--label L]\n"
+    "                      (--reference-file REF.csv | --analytic-reference)\n"
+    "       work_precision --reference-run --scene FILE --duration T --reference-kind extended_precision|dopri5\n"
+    "                      [--checkpoints t1,t2,...] --output REF.csv\n"
     "       work_precision --help | -h | --version\n"
-    "Exit status: 0 done; 1 failed (a file cannot be written, a scene cannot be loaded); 2 bad arguments.\n";
+    "--measure and --reference-run are one task of a study (scripts/study, docs/studies.md): one JSON row on stdout.\n"
+    "Exit status: 0 done; 1 failed (a file cannot be written, a scene cannot be loaded); 2 bad arguments;\n"
+    "4 the measured run failed (its row says why).\n";
 
 int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
@@ -261,6 +269,23 @@ int main(int argc, char** argv) {
     }
   }
   if (print_version_if_asked(argc, argv, "work_precision")) return 0;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg != "--measure" && arg != "--reference-run") continue;
+    SingleTask task;
+    try {
+      task = parse_single_task(argc, argv);
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "work_precision: %s\n%s", error.what(), kUsage);
+      return 2;
+    }
+    try {
+      return task.mode == "measure" ? run_measure_task(task) : run_reference_task(task);
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "work_precision: %s\n", error.what());
+      return 1;
+    }
+  }
   Options options;
   try {
     options = parse(argc, argv);

@@ -3,6 +3,7 @@
 // reference — in long double.
 #pragma once
 
+#include <algorithm>
 #include <array>
 // GCC 12 reports a false -Wmaybe-uninitialized in the copy constructor of odeint's
 // explicit_error_generic_rk (rkf78's buffers are sized by the initially_resizer before any use).
@@ -109,7 +110,7 @@ void integrate_through_checkpoints(Stepper& stepper, const Rates& rates, State& 
 }
 
 /// Odeint peers: odeint_rk4 (fixed h), odeint_dopri5, odeint_rkf78, odeint_bulirsch_stoer
-/// (controlled, absolute = relative tolerance).
+/// (controlled, absolute = relative tolerance) and odeint_bulirsch_stoer_dense_out.
 template <class System>
 RunRecord measure_odeint_typed(const BenchScene& bench, const std::string& method, double nominal_step,
                                double tolerance, int repetitions) {
@@ -160,6 +161,31 @@ RunRecord measure_odeint_typed(const BenchScene& bench, const std::string& metho
       } else if (method == "odeint_bulirsch_stoer") {
         odeint::bulirsch_stoer<Joint> stepper(tolerance, tolerance);
         integrate_through_checkpoints(stepper, rates, x, t0, bench.checkpoint_times, 1e-3, observe, at_checkpoint);
+      } else if (method == "odeint_bulirsch_stoer_dense_out") {
+        // Dense output: the extrapolation steps as large as the tolerance allows and the state is
+        // interpolated at the observation times (every kSampleInterval and every checkpoint).
+        odeint::bulirsch_stoer_dense_out<Joint> stepper(tolerance, tolerance);
+        std::vector<double> times{t0};
+        const std::uint64_t samples = step_count(bench.scene.duration, kSampleInterval);
+        for (std::uint64_t k = 1; k <= samples; ++k) {
+          times.push_back(t0 + bench.scene.duration * static_cast<double>(k) / static_cast<double>(samples));
+        }
+        for (double c : bench.checkpoint_times) times.push_back(t0 + c);
+        std::sort(times.begin(), times.end());
+        times.erase(std::unique(times.begin(), times.end(),
+                                [](double a, double b) { return std::abs(a - b) <= 1e-9 * (1.0 + std::abs(b)); }),
+                    times.end());
+        std::size_t next = 0;
+        odeint::integrate_times(stepper, rates, x, times.begin(), times.end(), 1e-3, [&](const Joint& state, double t) {
+          ++accepted;  // observation times, not the extrapolation's own steps
+          sample_joint(system, state, energy0, p20, e);
+          if (next < bench.checkpoint_times.size() &&
+              std::abs(t - (t0 + bench.checkpoint_times[next])) <= 1e-9 * (1.0 + std::abs(t))) {
+            at_checkpoint(next++, state, t);
+          }
+          x_end = state;
+        });
+        return e;
       } else if (method == "odeint_rk4") {
         const std::vector<std::uint64_t> checkpoints = checkpoint_steps(bench, steps);
         const std::uint64_t sample_every = std::max<std::uint64_t>(1, std::llround(kSampleInterval / h));
