@@ -37,6 +37,7 @@
 #include "birkhoff_cart/core/integrators/cart_stepper.h"
 #include "birkhoff_cart/core/paper_form_drift.h"
 #include "birkhoff_cart/core/run_summary.h"
+#include "birkhoff_cart/core/random_scene.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
 #include "birkhoff_cart/core/step_schedule.h"
@@ -57,7 +58,8 @@ constexpr double kProgressPeriod = 1.0;  // at most one progress line per this m
 const char* const kUsage =
     "usage: cart_simulate --scene FILE [--integrator NAME] [--step H] [--tolerance TOL]\n"
     "                     [--duration T] [--output-rate HZ] [--birkhoffian-form F] [--quiet]\n"
-    "                     [--step-control fixed|reversible] [--on-accuracy-error fail|warn] --output FILE.csv\n"
+    "                     [--step-control fixed|reversible] [--on-accuracy-error fail|warn]\n"
+    "                     [--random-scene SEED:K] --output FILE.csv\n"
     "       cart_simulate --help | -h | --version\n"
     "  --scene FILE            scene YAML (config/scenes/*.yaml); it provides every default\n"
     "  --integrator NAME       birkhoff2, birkhoff4, birkhoff_gauss4, birkhoff_gauss6, birkhoff_gauss8,\n"
@@ -72,6 +74,9 @@ const char* const kUsage =
     "  --output-rate HZ        output rows per simulated second [Hz], > 0\n"
     "  --birkhoffian-form F    autonomous or paper\n"
     "  --quiet                 no progress lines on stderr\n"
+    "  --random-scene SEED:K   scene K of the seeded random family (a random valid cart, start, step,\n"
+    "                          duration and effects; docs/accuracy.md §3) instead of the file's, which\n"
+    "                          gives the rest (integrator, accuracy guard); the other options still apply\n"
     "  --on-accuracy-error A   fail (default: exit 5 when the scene's accuracy guard reaches ERROR)\n"
     "                          or warn (exit 0; the summary still names the quantity)\n"
     "  --output FILE.csv       where to write t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,\n"
@@ -112,7 +117,7 @@ bool asks_for_help(int argc, char** argv) {
 std::map<std::string, std::string> parse_arguments(int argc, char** argv) {
   static const char* const kOptions[] = {"--scene",       "--integrator",       "--step",  "--tolerance",
                                          "--duration",    "--output-rate",      "--birkhoffian-form", "--output",
-                                         "--on-accuracy-error", "--step-control"};
+                                         "--on-accuracy-error", "--step-control", "--random-scene"};
   std::map<std::string, std::string> values;
   for (int i = 1; i < argc; ++i) {
     const std::string option = argv[i];
@@ -131,6 +136,19 @@ std::map<std::string, std::string> parse_arguments(int argc, char** argv) {
   if (!values.count("--scene")) throw UsageError("missing --scene FILE");
   if (!values.count("--output")) throw UsageError("missing --output FILE.csv");
   return values;
+}
+
+/// Scene K of the random family SEED ("SEED:K", both whole numbers ≥ 0), on `base`.
+Scene random_scene(const std::string& text, const Scene& base) {
+  const auto colon = text.find(':');
+  const auto whole = [&](const std::string& part) {
+    if (part.empty() || part.size() > 19 || part.find_first_not_of("0123456789") != std::string::npos) {
+      throw UsageError("option --random-scene needs SEED:K with whole numbers SEED, K >= 0, got '" + text + "'");
+    }
+    return static_cast<std::uint64_t>(std::stoull(part));
+  };
+  if (colon == std::string::npos) whole("");
+  return birkhoff_cart::RandomSceneFamily(whole(text.substr(0, colon))).scene(base, whole(text.substr(colon + 1)));
 }
 
 /// Applies the command-line overrides to the scene's settings.
@@ -234,6 +252,7 @@ int run(int argc, char** argv) {
   try {
     arguments = parse_arguments(argc, argv);
     scene = birkhoff_cart::load_scene(arguments.at("--scene"));
+    if (arguments.count("--random-scene")) scene = random_scene(arguments.at("--random-scene"), scene);
     apply_overrides(arguments, scene);
   } catch (const UsageError& error) {
     std::fprintf(stderr, "cart_simulate: %s\n%s", error.what(), kUsage);
