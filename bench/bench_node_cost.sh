@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Node cost (issue 13, docs/benchmarks.md "Node cost"): cart_sim on the default scene with birkhoff2 at h = 1 ms
-# (the stepping the issue defines; the scene itself now defaults to birkhoff_gauss4 at 10 ms,
+# Node cost (docs/benchmarks.md, "The node's cost"): cart_sim on the default scene with birkhoff2 at h = 1 ms
+# (the cheapest Birkhoffian 1 kHz stepping; the scene itself now defaults to birkhoff_gauss4 at 10 ms,
 # 100 Hz publishing, its dopri5 shadow reference on) in fast mode for 300 s of scene time, with and
 # without the bag, beside cart_simulate on the same scene and duration (the bare core with CSV at
 # 100 Hz), three times each; then lockstep with steering_pd_controller (driven.yaml, 60 s at 50 Hz)
@@ -55,7 +55,7 @@ timed() {  # $1 output file for "wall user sys"; the rest: the command
   /usr/bin/time -f "%e %U %S" -o "$out" "$@"
 }
 
-stepping="_integrator:=birkhoff2 _step_size:=0.001"      # the issue's stepping (node)
+stepping="_integrator:=birkhoff2 _step_size:=0.001"      # birkhoff2 at 1 kHz (node)
 core_stepping="--integrator birkhoff2 --step 0.001"      # the same for cart_simulate
 node_fast() {  # $1 label, $2 extra parameters -> "node_wall node_loop_rtf node_cpu"
   rosparam delete /cart_sim > /dev/null 2>&1 || true
@@ -92,7 +92,7 @@ fast_table() {  # $1 title; three runs of node with bag, without, and cart_simul
 }
 
 echo "load before: $(cat /proc/loadavg)"
-fast_table "default scene, birkhoff2 at h = 1 ms (the issue's stepping), 100 Hz, $duration s:"
+fast_table "default scene, birkhoff2 at h = 1 ms , 100 Hz, $duration s:"
 read -r none_wall none_rtf none_cpu <<< "$(node_fast "bag_none" "_bag_path:=$work/node_none.bag _bag_compression:=none")"
 echo "  bag uncompressed (~bag_compression none): wall $none_wall s (loop ${none_rtf}x) / CPU $none_cpu s; $(ls -l "$work/node_none.bag" | awk '{print $5}') bytes"
 stepping=""; core_stepping=""

@@ -3,7 +3,7 @@
 of the repository, builds only the test targets that should notice, runs those tests, and fails
 (exit status 1) if any mutation survives — i.e. if every one of its tests still passes.
 
-Usage: /usr/bin/python3 checks/mutation_check.py [--scratch DIR] [--only NAME ...] [--list]
+Usage: /usr/bin/python3 checks/mutation_check.py [--scratch DIR] [--only NAME ...] [--list] [--check-targets]
 
 The working tree is never modified: the tracked files are copied (git ls-files) to
 DIR/src/birkhoff_cart (default: $TMPDIR/birkhoff_cart_mutation), configured once with CMake
@@ -49,17 +49,17 @@ MUTATIONS = [
         "birkhoff4_weights",
         "birkhoff4 composes birkhoff2 with equal weights 1/3 (birkhoff2's order) instead of the triple jump",
         "include/birkhoff_cart/core/integrators/birkhoff_symplectic.h",
-        "static double outer_weight() { return 1.0 / (2.0 - std::cbrt(2.0)); }",
-        "static double outer_weight() { return 1.0 / 3.0; }",
-        [(TRAJECTORY, "*birkhoff4*"), ("registry_properties_test", "*birkhoff4*")],
+        "const double outer = 1.0 / (2.0 - std::cbrt(2.0));  // γ₁ = γ₃ ≈ 1.3512",
+        "const double outer = 1.0 / 3.0;",
+        [(TRAJECTORY, "*"), ("registry_properties_test", "*")],
     ),
     Mutation(
         "chart_time_at_step_end",
-        "birkhoff2 leaves the Darboux chart at tₖ instead of tₖ₊₁",
-        "include/birkhoff_cart/core/integrators/birkhoff_symplectic.h",
-        "z = system.from_darboux(w_next, S(t_next));",
-        "z = system.from_darboux(w_next, S(t_next - h));",  # = tₖ (t_next stays used: -Werror)
-        [(TRAJECTORY, "*paper*"), ("k_symplectic_test", "*")],
+        "the collocation step leaves the Darboux chart at tₖ instead of tₖ₊₁",
+        "include/birkhoff_cart/core/integrators/gauss_collocation.h",
+        "z = system.from_darboux(w_next, S(t + h));",
+        "z = system.from_darboux(w_next, S(t));",
+        [(TRAJECTORY, "*"), ("k_symplectic_test", "*")],
     ),
     Mutation(
         "dropped_air_drag_force",
@@ -67,16 +67,16 @@ MUTATIONS = [
         "src/core/effects/air_drag.cpp",
         "total.force(0) += -k * std::abs(speed_a) * speed_a * c;",
         "static_cast<void>(c);",
-        [(TRAJECTORY, "*birkhoff2*"), ("effects_test", "*"), ("independent_model_test", "*")],
+        [(TRAJECTORY, "*"), ("effects_test", "*"), ("independent_model_test", "*")],
     ),
     Mutation(
         "odom_at_hinge",
         "odometry reports the hinge B instead of base_link at the rear-axle midpoint A",
         "src/ros/conversions.cpp",
-        "nav_msgs::Odometry to_odometry(const CartState& state, const CartModel& model, const FrameNames& frames) {\n"
-        "  const Eigen::Vector2d rear_axle_midpoint = model.rear_axle_midpoint(state);",
-        "nav_msgs::Odometry to_odometry(const CartState& state, const CartModel& model, const FrameNames& frames) {\n"
-        "  const Eigen::Vector2d rear_axle_midpoint(state.x, state.y + 0.0 * model.parameters().wheelbase);",
+        "const Eigen::Vector2d rear_axle_midpoint = model.rear_axle_midpoint(state);  // A [m]\n"
+        "  const Vector2<double> quasi_velocity(",
+        "const Eigen::Vector2d rear_axle_midpoint(state.x, state.y + 0.0 * model.parameters().wheelbase);\n"
+        "  const Vector2<double> quasi_velocity(",
         [("conversions_test", "*")],
     ),
     Mutation(
@@ -88,12 +88,78 @@ MUTATIONS = [
         [("bad_input_test", "*"), ("simulation_test", "*")],
     ),
     Mutation(
-        "passive_left_point",
-        "birkhoff2's passive coordinates use the left point (z⁽ᵏ⁾, tₖ) instead of the midpoint",
-        "include/birkhoff_cart/core/integrators/birkhoff_symplectic.h",
-        "y = passive_midpoint(system, z_mid, y, t_mid, h, statistics);",
-        "static_cast<void>(z_mid);\n    y = passive_midpoint(system, z, y, t, h, statistics);",
-        [(TRAJECTORY, "*birkhoff2*"), ("integrator_contract_test", "*birkhoff2*")],
+        "passive_rates_at_first_stage",
+        "the passive coordinates (x, y, θ, φ) are integrated with every stage's rate taken at the first stage",
+        "include/birkhoff_cart/core/integrators/gauss_collocation.h",
+        "passive_rates[j] = passive_coordinate_rates(system, stage_points[j], passive_stages[j], S(stage_times[j]));",
+        "passive_rates[j] = passive_coordinate_rates(system, stage_points[0], passive_stages[0], S(stage_times[0]));",
+        [(TRAJECTORY, "*"), ("integrator_contract_test", "*")],
+    ),
+    Mutation(
+        "gauss_tableau_rows",
+        "a Gauss–Legendre coefficient aᵢⱼ integrates the basis up to the wrong node (rows swapped)",
+        "src/core/integrators/gauss_legendre_tableau.cpp",
+        "tableau.coefficients[i][j] = static_cast<double>(integrate_basis(nodes, s, j, 0.0L, nodes[i]));",
+        "tableau.coefficients[i][j] = static_cast<double>(integrate_basis(nodes, s, j, 0.0L, nodes[s - 1 - i]));",
+        [(TRAJECTORY, "*"), ("integrator_contract_test", "*"), ("k_symplectic_test", "*")],
+    ),
+    Mutation(
+        "compensated_summation_dropped",
+        "the compensated (TwoSum) state update silently falls back to plain summation",
+        "include/birkhoff_cart/core/integrators/gauss_collocation.h",
+        "const bool compensate = settings_.compensated && collocation_detail::LinearChart<System>::value;\n"
+        "    if (!compensate) {",
+        "const bool compensate = false && settings_.compensated && collocation_detail::LinearChart<System>::value;\n"
+        "    if (!compensate) {",
+        [("gauss_collocation_test", "*")],
+    ),
+    Mutation(
+        "angle_reduction_turns",
+        "the angle reduction loses the whole turns it removes",
+        "include/birkhoff_cart/core/angle_reduction.h",
+        "  remainder -= k * kTwoPiLow;\n  turns += k;",
+        "  remainder -= k * kTwoPiLow;\n  turns += 0.0 * k;",
+        [("gauss_collocation_test", "*"), ("long_run_test", "*")],
+    ),
+    Mutation(
+        "reversible_rho_update",
+        "the reversible step control's second half-update of ρ is dropped (the map is no longer symmetric)",
+        "include/birkhoff_cart/core/integrators/reversible_step_control.h",
+        "rho_ = rho_half + 0.5 * epsilon * log_rate_;",
+        "rho_ = rho_half;",
+        [("reversible_step_control_test", "*")],
+    ),
+    Mutation(
+        "error_estimate_weights",
+        "the local error estimate's end-point weight has the wrong sign",
+        "src/core/integrators/gauss_legendre_tableau.cpp",
+        "tableau.estimate_weights[s + 1] = static_cast<double>(-end_sign * beta);",
+        "tableau.estimate_weights[s + 1] = static_cast<double>(end_sign * beta);",
+        [("error_estimate_test", "*")],
+    ),
+    Mutation(
+        "accuracy_guard_comparison",
+        "the accuracy guard compares with the warning limit where the error limit belongs",
+        "src/core/accuracy_guard.cpp",
+        "if (value > limit.error) note(quantity, AccuracyLevel::kError, limit.error);",
+        "if (value > limit.warn) note(quantity, AccuracyLevel::kError, limit.error);",
+        [("accuracy_guard_test", "*")],
+    ),
+    Mutation(
+        "cmd_vel_timeout_ignored",
+        "cmd_vel_controller never notices that cmd_vel fell silent (the cart keeps driving)",
+        "src/ros/cmd_vel_controller.cpp",
+        "const bool silent = has_command_ && s.cmd_vel_timeout > 0.0 && feedback.time - command_time_ > s.cmd_vel_timeout;",
+        "const bool silent = has_command_ && s.cmd_vel_timeout < 0.0 && feedback.time - command_time_ > s.cmd_vel_timeout;",
+        [("cmd_vel_controller_test", "*")],
+    ),
+    Mutation(
+        "bag_index_chunk_count",
+        "the bag's file header counts one chunk fewer than it holds",
+        "src/ros/bag_file_writer.cpp",
+        'append_value_field(out, "chunk_count", static_cast<std::uint32_t>(chunks_.size()));',
+        'append_value_field(out, "chunk_count", static_cast<std::uint32_t>(chunks_.size() - 1));',
+        [("bag_file_writer_test", "*")],
     ),
 ]
 
@@ -149,17 +215,41 @@ def build_and_run(build: pathlib.Path, tests, log):
     return True, failing, passing
 
 
+def check_targets(mutations, root=REPO) -> int:
+    """Exit status 0 when every mutation can still be applied: its target text occurs exactly once
+    and the mutated text differs from it; otherwise 1, naming each stale mutation."""
+    stale = []
+    for mutation in mutations:
+        path = root / mutation.path
+        count = path.read_text().count(mutation.original) if path.is_file() else -1
+        if count != 1 or mutation.mutated == mutation.original:
+            where = "file missing" if count < 0 else f"target found {count} times"
+            stale.append(f"{mutation.name}: {where} in {mutation.path}")
+    for line in stale:
+        print(f"mutation_check: STALE {line}: update the mutation where the code moved")
+    print(f"mutation_check: {len(mutations) - len(stale)} of {len(mutations)} mutation targets apply")
+    return 1 if stale else 0
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scratch", type=pathlib.Path,
                         default=pathlib.Path(tempfile.gettempdir()) / "birkhoff_cart_mutation")
     parser.add_argument("--only", nargs="*", help="names of the mutations to apply (default: all)")
     parser.add_argument("--list", action="store_true", help="list the mutations and exit")
+    parser.add_argument("--check-targets", action="store_true",
+                        help="only check, in seconds and without building, that every mutation's target text "
+                             "occurs exactly once in the working tree (CI runs this on every change)")
+    parser.add_argument("--root", type=pathlib.Path, default=REPO,
+                        help="with --check-targets: the source tree to check (default: this repository)")
     arguments = parser.parse_args()
     if arguments.list:
         for mutation in MUTATIONS:
-            print(f"{mutation.name}: {mutation.why} ({mutation.path})")
+            tests = ", ".join(target for target, _ in mutation.tests)
+            print(f"{mutation.name}: {mutation.why} ({mutation.path}; killed by {tests})")
         return 0
+    if arguments.check_targets:
+        return check_targets(MUTATIONS, arguments.root.resolve())
     chosen = [m for m in MUTATIONS if not arguments.only or m.name in arguments.only]
     unknown = set(arguments.only or []) - {m.name for m in MUTATIONS}
     if unknown:

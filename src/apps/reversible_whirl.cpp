@@ -1,5 +1,5 @@
 // reversible_whirl: the reversible adaptive step against the same member at fixed steps on the
-// free jackknife_whirl (issue 12 goal; docs/accuracy.md §4.2). ROS-free.
+// free jackknife_whirl (docs/accuracy.md §4.2). ROS-free.
 //
 //   reversible_whirl [--duration T] [--member NAME] [--output-dir DIR]
 //   (defaults: 10 000 s, birkhoff_gauss4, bench/results; run from the repository)

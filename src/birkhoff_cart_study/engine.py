@@ -7,7 +7,9 @@ task whose process crashes or passes its time limit comes back as a failed row, 
 never hangs on one task."""
 import json
 import logging
+import fcntl
 import os
+import signal
 import sys
 import time
 
@@ -126,6 +128,11 @@ def run_study(study, tasks, output_dir, bin_dir, scheduler=None, workers=None, s
     from distributed import as_completed
     os.makedirs(output_dir, exist_ok=True)
     rows_path = os.path.join(output_dir, ROWS_FILE)
+    lock = open(os.path.join(output_dir, ".lock"), "w")
+    try:
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)  # held until this process ends
+    except OSError:
+        raise RuntimeError("another study runner is writing %s; wait for it or stop it first" % output_dir)
     previous = latest_rows(read_rows(rows_path))
     if retry_failed:
         previous = [row for row in previous if row.get("outcome") not in ("failed", "timeout")]
@@ -158,19 +165,35 @@ def run_study(study, tasks, output_dir, bin_dir, scheduler=None, workers=None, s
                 continue
             reference = references.get(task.get("reference")) if task["type"] == "measure" and not task.get("analytic") else None
             future = client.submit(run_task, task, bin_dir, reference, key="task-" + task["id"], pure=False,
-                                   retries=TASK_RETRIES, priority=-len(futures))
+                                   retries=TASK_RETRIES, priority=expected_cost(task))
             futures[future] = task
-        for future in as_completed(list(futures)):
-            task = futures[future]
-            try:
-                row = future.result()
-            except Exception as error:  # the task could not run at all (e.g. its workers kept dying)
-                row = {k: v for k, v in task.items() if k != "scene_text"}
-                row.update(task_id=task["id"], outcome="failed", reason="%s: %s" % (type(error).__name__, error))
-            row["workers"] = worker_count
-            writer.write(row)
-            new_rows.append(row)
-            progress.update(row)
+        # SIGINT and SIGTERM stop the study between rows: polled, because a wait inside Dask's
+        # client does not always let Python's KeyboardInterrupt through.
+        stop = []
+        previous_handlers = {sig: signal.signal(sig, lambda number, frame: stop.append(number))
+                             for sig in (signal.SIGINT, signal.SIGTERM)}
+        try:
+            pending = as_completed(list(futures))
+            while not pending.is_empty() and not stop:
+                for future in pending.next_batch(block=False):
+                    task = futures[future]
+                    try:
+                        row = future.result()
+                    except Exception as error:  # the task could not run at all (e.g. its workers kept dying)
+                        row = {k: v for k, v in task.items() if k != "scene_text"}
+                        row.update(task_id=task["id"], outcome="failed",
+                                   reason="%s: %s" % (type(error).__name__, error))
+                    row["workers"] = worker_count
+                    writer.write(row)
+                    new_rows.append(row)
+                    progress.update(row)
+                time.sleep(0.05)
+        finally:
+            for sig, handler in previous_handlers.items():
+                signal.signal(sig, handler)
+        if stop:
+            client.cancel(list(futures))
+            raise KeyboardInterrupt
     finally:
         writer.close()
         client.close()
@@ -187,6 +210,15 @@ def run_study(study, tasks, output_dir, bin_dir, scheduler=None, workers=None, s
                % (study["name"], len(tasks), ", ".join("%d %s" % (n, k) for k, n in sorted(counts.items())),
                   len(new_rows), len(tasks) - len(todo), _duration(wall), _duration(cpu), worker_count, rows_path))
     return rows, summary
+
+
+def expected_cost(task):
+    """A rough rank of a task's cost (larger runs first, so that the longest ones do not start last
+    and leave the other workers idle at the end): the simulated time, and for a fixed step the
+    number of steps."""
+    duration = task.get("duration") or 1.0
+    steps = duration / task["step"] if task.get("step") else duration * 10.0
+    return int(min(steps, 1e12))
 
 
 def _reference_text(row):

@@ -192,6 +192,59 @@ def simulate_tables(rows):
     return "\n".join(lines), "\n".join(reason_lines)
 
 
+def reference_distances(reference_text, check_text):
+    """[(t, distance of the hinge B between the two runs [m])] at every checkpoint of both files."""
+    def states(text):
+        rows = {}
+        for line in text.splitlines():
+            if line and not line.startswith(("#", "t,")):
+                t, x, y = (float(v) for v in line.split(",")[:3])
+                rows[t] = (x, y)
+        return rows
+    a, b = states(reference_text), states(check_text)
+    return [(t, math.hypot(a[t][0] - b[t][0], a[t][1] - b[t][1])) for t in sorted(a) if t in b]
+
+
+def reference_tables(rows):
+    """Runs judged against a reference of their own scene (cart_simulate studies with `reference`):
+    error at the end / tolerance per scene, member and tolerance, '?' where the reference and its
+    check disagree by more than a tenth of the tolerance."""
+    out, within, total, worst = [], 0, 0, 0.0
+    simulate = [r for r in rows if r.get("type") == "simulate"]
+    for scene in sorted({r["scene"] for r in simulate if r.get("judged_against_reference")}):
+        refs = {r["role"]: r for r in simulate if r["scene"] == scene and r.get("role")}
+        ref, check = refs.get("reference"), refs.get("reference_check")
+        if not (ref and check and ref.get("outcome") == "ok" and check.get("outcome") == "ok"):
+            out += ["**%s**: the reference failed" % scene, ""]
+            continue
+        spread = math.hypot(ref["result"]["x"] - check["result"]["x"], ref["result"]["y"] - check["result"]["y"])
+        runs = [r for r in simulate if r["scene"] == scene and r.get("judged_against_reference")]
+        tolerances = sorted({r["tolerance"] for r in runs}, reverse=True)
+        out += ["**%s**: reference %s at h = %.3g s and h/2 agree to %.2g m." % (scene, ref["method"], check["step"] * 2, spread), "",
+                "| member | " + " | ".join("%g" % t for t in tolerances) + " |", "|---|" + "---|" * len(tolerances)]
+        for method in sorted({r["method"] for r in runs}):
+            cells = []
+            for t in tolerances:
+                run = next((r for r in runs if r["method"] == method and r["tolerance"] == t), None)
+                if run is None or run.get("outcome") != "ok":
+                    cells.append("failed" if run else "—")
+                    continue
+                error = math.hypot(run["result"]["x"] - check["result"]["x"], run["result"]["y"] - check["result"]["y"])
+                ratio = error / t
+                total += 1
+                within += ratio <= 10.0
+                worst = max(worst, ratio)
+                rhs = run["result"].get("rhs_evaluations")
+                cells.append("%.2g%s (%s rhs)" % (ratio, "" if 10 * spread <= t else "?", rhs if rhs is not None else "?"))
+            out.append("| `%s` | %s |" % (method, " | ".join(cells)))
+        out.append("")
+    if total:
+        out.insert(0, "Final position error / tolerance (and rhs evaluations): %d of %d runs within 10× of the "
+                      "tolerance, worst %.3g ('?': the reference is not 10× tighter than that tolerance)." % (within, total, worst))
+        out.insert(1, "")
+    return "\n".join(out)
+
+
 def write_report(study, rows, page_path, command, summary, labels=()):
     """Writes the results page (markdown) and its plots beside it (<page stem>_*.png)."""
     stem = os.path.splitext(page_path)[0]
@@ -218,17 +271,21 @@ def write_report(study, rows, page_path, command, summary, labels=()):
             "so a ratio above 1 means the Birkhoffian member is cheaper. Errors are deterministic and do not "
             "depend on the number of workers.", ""]
     references = [r for r in rows if r.get("type") == "reference"]
+    checks = {r["label"]: r for r in rows if r.get("type") == "reference_check"}
     if references:
-        out += ["## References", "", "| reference | kind | its distance from the check setting at each checkpoint [m] |",
-                "|---|---|---|"]
+        out += ["## References", "",
+                "| reference | scene, span | reference setting vs its check | their distance, largest over the checkpoints (at the end) [m] |",
+                "|---|---|---|---|"]
         for r in references:
-            if r.get("outcome") == "ok":
-                d = r["result"]["check_position_difference_m"]
-                out.append("| %s (%s, %s s) | %s vs %s | max %.2g (at the end %.2g) |" % (
-                    r["label"], r["scene"], "%g" % r["duration"], r["result"]["reference"], r["result"]["check"],
-                    max(x[1] for x in d), d[-1][1]))
+            check = checks.get(r["label"])
+            if r.get("outcome") == "ok" and check and check.get("outcome") == "ok":
+                d = reference_distances(r["reference_text"], check["reference_text"])
+                out.append("| %s | %s, %g s | %s vs %s | %.2g (%.2g) |" % (
+                    r["label"], r["scene"], r["duration"], r["result"]["reference"], check["result"]["reference"],
+                    max(x for _, x in d), d[-1][1]))
             else:
-                out.append("| %s | %s | failed: %s |" % (r["label"], r.get("reference_kind"), r.get("reason")))
+                out.append("| %s | %s | failed | %s |" % (r["label"], r.get("reference_kind"),
+                                                         (r.get("reason") or (check or {}).get("reason") or "no check row")))
         out.append("")
     runs = measurements(rows)
     present = {r["label"] for r in runs}
@@ -247,6 +304,9 @@ def write_report(study, rows, page_path, command, summary, labels=()):
     if any(r.get("type") == "simulate" for r in rows):
         outcomes, reasons = simulate_tables(rows)
         out += ["## Outcomes", "", outcomes, "", "Refusals and failures by reason:", "", reasons, ""]
+        judged = reference_tables(rows)
+        if judged:
+            out += ["## Against the reference", "", judged, ""]
     stepless = [r for r in rows if r.get("outcome") == "step_failed"]
     if stepless:
         out += ["## Runs whose step failed", "",

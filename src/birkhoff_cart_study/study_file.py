@@ -45,7 +45,8 @@ MEASURE_EXPERIMENT_KEYS = {"label", "scene", "duration", "reference", "checkpoin
 RUN_KEYS = {"steps", "tolerances", "simulator_steps"}
 RANDOM_KEYS = {"seed", "count", "first", "base"}
 RANDOM_RUN_KEYS = {"seed", "count", "scenes"}
-CLI_EXPERIMENT_KEYS = {"label", "scenes", "random_scenes", "random_runs", "integrators", "steps", "tolerances", "durations", "step_control",
+CLI_REFERENCE_KEYS = {"integrator", "step"}
+CLI_EXPERIMENT_KEYS = {"label", "scenes", "random_scenes", "random_runs", "integrators", "end_only", "reference", "steps", "tolerances", "durations", "step_control",
                        "birkhoffian_forms", "output_rates", "expect"}
 
 
@@ -193,7 +194,12 @@ def _measurement_tasks(path, doc, experiments, integrators, scene_dir, study):
             "duration": duration, "checkpoints": _checkpoints(path, where + ".checkpoints", ref.get("checkpoints"), duration),
             "time_limit": study["time_limit"]}
     known_methods = [m for m in integrators] + list(ODEINT_PEERS)
-    tasks = [t for t in reference_tasks.values() if t is not None]
+    tasks = []
+    for reference in reference_tasks.values():
+        if reference is not None:
+            # The setting the reference is checked against runs as a task of its own, in parallel:
+            # the measurements wait only for the reference.
+            tasks += [reference, dict(reference, type="reference_check")]
     labels = set()
     for i, experiment in enumerate(experiments):
         where = "experiments[%d]" % i
@@ -347,8 +353,35 @@ def _cli_tasks(path, experiments, integrators, scene_dir, study):
         expect = experiment.get("expect", "finish")
         if expect not in ("finish", "finish_or_refuse"):
             _fail(path, where + ".expect", "must be finish or finish_or_refuse, got %r" % (expect,))
+        end_only = experiment.get("end_only", False)
+        if not isinstance(end_only, bool):
+            _fail(path, where + ".end_only", "must be true or false, got %r" % (end_only,))
+        reference = experiment.get("reference")
+        if reference is not None:
+            _check_keys(path, where + ".reference", reference, CLI_REFERENCE_KEYS)
+            if reference.get("integrator") not in integrators:
+                _fail(path, where + ".reference.integrator", "unknown integrator %r" % (reference.get("integrator"),))
+            reference_step = _positive(path, where + ".reference.step", reference.get("step"))
+            if randoms != [None]:
+                _fail(path, where + ".reference", "not with random_scenes")
         for scene_file, random in [(f, r) for f in scenes for r in randoms]:
             scene_text = open(scene_file).read()
+            scene_duration = None
+            if end_only or reference is not None:
+                try:
+                    scene_duration = float(yaml.safe_load(scene_text)["duration"])
+                except (KeyError, TypeError, ValueError, yaml.YAMLError):
+                    _fail(path, where + ".scenes", "scene %s has no duration to end on" % os.path.basename(scene_file))
+            if reference is not None:
+                # The same member at a step and at half of it, both landing on the end: the runs are
+                # judged against the finer one, and the two must agree 10× tighter than a verdict.
+                count = max(1, round(scene_duration / reference_step))
+                for role, h in (("reference", scene_duration / count), ("reference_check", scene_duration / count / 2)):
+                    tasks.append({"type": "simulate", "study": study["name"], "label": experiment["label"],
+                                  "scene": os.path.basename(scene_file), "scene_text": scene_text,
+                                  "method": reference["integrator"], "step_control": "fixed", "expect": "finish",
+                                  "time_limit": study["time_limit"], "role": role, "step": h,
+                                  "output_rate": 1.0 / scene_duration})
             for method in methods:
                 for h in steps:
                     for tol in tolerances:
@@ -359,10 +392,14 @@ def _cli_tasks(path, experiments, integrators, scene_dir, study):
                                             "scene": os.path.basename(scene_file), "scene_text": scene_text,
                                             "method": method, "step_control": control, "expect": expect,
                                             "time_limit": study["time_limit"]}
+                                    if end_only:  # one output step: the end
+                                        h, rate = scene_duration, 1.0 / scene_duration
                                     for key, value in (("step", h), ("tolerance", tol), ("duration", duration),
                                                        ("output_rate", rate), ("birkhoffian_form", form),
                                                        ("random_scene", random)):
                                         if value is not None:
                                             task[key] = value
+                                    if reference is not None:
+                                        task["judged_against_reference"] = True
                                     tasks.append(task)
     return tasks

@@ -5,6 +5,7 @@ executables (`bin_dir`, the same path on every worker). The scene travels inside
 workers need no shared file system."""
 import json
 import os
+import re
 import shutil
 import signal
 import socket
@@ -86,9 +87,11 @@ def run_task(task, bin_dir, reference_text=None):
             return _simulate(task, row, bin_dir, scene, work_dir)
         command = [os.path.join(bin_dir, "work_precision"), "--scene", scene, "--duration", repr(task["duration"]),
                    "--checkpoints", ",".join(repr(t) for t in task["checkpoints"]), "--label", task["label"]]
-        if task["type"] == "reference":
+        if task["type"] in ("reference", "reference_check"):
             output = os.path.join(work_dir, "reference.csv")
             command += ["--reference-run", "--reference-kind", task["reference_kind"], "--output", output]
+            if task["type"] == "reference_check":
+                command += ["--check-setting"]
         else:
             command += ["--measure", "--method", task["method"], "--repetitions", str(task["repetitions"])]
             if "step" in task:
@@ -116,7 +119,7 @@ def run_task(task, bin_dir, reference_text=None):
                 result = None
         if result is not None:
             row["result"] = result
-        if task["type"] == "reference" and status == 0 and result is not None:
+        if task["type"] in ("reference", "reference_check") and status == 0 and result is not None:
             with open(output) as f:
                 row["reference_text"] = f.read()
         if timed_out:
@@ -163,6 +166,9 @@ def _simulate(task, row, bin_dir, scene, work_dir):
             row["rows"] = len(lines) - 1
     if last:
         row["result"] = {k: last.get(k) for k in ("t", "x", "y", "theta", "chi", "energy", "p2")}
+        rhs = re.search(r"(\d+) rhs evaluations", stdout)
+        if rhs:
+            row["result"]["rhs_evaluations"] = int(rhs.group(1))
     if not timed_out:
         outcome, reason = judge(status, stderr, csv, task.get("start_time"), task.get("duration"), task.get("step", 0.0))
         if outcome == "refused" and task.get("expect") != "finish_or_refuse":

@@ -1,4 +1,4 @@
-// rostest node_end_time: regression of issue 17 (one rule for how a run is cut into steps). cart_sim
+// rostest node_end_time: one rule for how a run is cut into steps. cart_sim
 // stopped at the first step with t + h/2 > t0 + T: a duration off the step grid ended up to half a
 // step late (0.0105 s at h = 1 ms ended at 0.011 s), its last published instant was before the end,
 // and the state differed from cart_simulate's. Now both take whole steps onto t0 + n h and one
@@ -145,7 +145,7 @@ TEST(NodeEndTime, SceneDurationOffTheStepGridEndsExactlyAtTheEnd) {
 
 TEST(NodeEndTime, DurationParameterWithinASliverOfTheGridEndsExactlyAtTheEnd) {
   // From t0 = 1 s, 4.6960000000005 s at h = 1 ms: the end lies 5e-13 s past the grid point 5.696 s
-  // (issue 17's abort of cart_simulate). The old node ended at 5.696 s; now the last step, from
+  // (where cart_simulate and the node once disagreed). The last step, from
   // 5.695 s, lands on 5.6960000000005 s.
   const std::string text = edited(read_file(scene_parameter()), "  time: 0.0 ", "  time: 1.0 ");
   const std::string duration = "4.6960000000005";

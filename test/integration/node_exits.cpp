@@ -1,4 +1,4 @@
-// rostest node_exits: regressions of issue 13 (exits and records) and issue 17 item 2.
+// rostest node_exits: exits and records.
 //  - INFO lines reach a log file while the node runs (stdout was fully buffered into a file, so
 //    they appeared only at exit).
 //  - The summary's real-time factor is scene time over the wall time *not paused*.

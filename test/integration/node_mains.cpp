@@ -1,4 +1,4 @@
-// rostest node_mains: regression of issue 17 ("no exception escapes main of any executable").
+// rostest node_mains: no exception escapes main of any executable.
 // ros::init, NodeHandle, advertise and subscribe throw ros::InvalidNameException for a node name,
 // namespace or remapping roscpp refuses; every node let it escape main (std::terminate, exit 134,
 // no line of its own). steering_driver's timer threw std::runtime_error for ~rate 1e-12 Hz (a

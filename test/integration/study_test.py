@@ -160,7 +160,7 @@ class StudyRunnerTest(unittest.TestCase):
         self.assertEqual(self.local.returncode, 0, self.local.stderr)
         rows = read_rows(self.local_dir)
         measures = [r for r in rows if r["type"] == "measure"]
-        self.assertEqual(len(rows), 17)  # 1 reference + 14 + 2 measurements
+        self.assertEqual(len(rows), 18)  # a reference, its check, 14 + 2 measurements
         self.assertEqual(len({r["task_id"] for r in rows}), len(rows))
         for row in measures:
             for field in ROW_FIELDS:
@@ -172,7 +172,7 @@ class StudyRunnerTest(unittest.TestCase):
             self.assertGreater(row["process_cpu_s"], 0.0)
         gauss8 = [r for r in measures if r["method"] == "birkhoff_gauss8" and r["step"] == 0.05][0]
         self.assertLess(gauss8["result"]["position_error_m"], 1e-7)  # eighth order at 50 ms over 30 s
-        self.assertIn("study small_test_study: 17 tasks: 17 ok", self.local.stdout)
+        self.assertIn("study small_test_study: 18 tasks: 18 ok", self.local.stdout)
         self.assertIn("tasks done", self.local.stderr)
         with open(os.path.join(self.local_dir, "results.md")) as f:
             page = f.read()
@@ -191,13 +191,38 @@ class StudyRunnerTest(unittest.TestCase):
             f.write(lines[6][:40])  # a row torn by the interruption: absent, not half there
         result = run_study(self.study, "--output-dir", directory, "--workers", "1")
         self.assertEqual(result.returncode, 0, result.stderr)
-        self.assertIn("17 tasks, 6 already done, 11 to run", result.stderr)
+        self.assertIn("18 tasks, 6 already done, 12 to run", result.stderr)
         rows = read_rows(directory)
-        self.assertEqual(len(rows), 17)
+        self.assertEqual(len(rows), 18)
         self.assertEqual(errors_by_task(rows), errors_by_task(read_rows(self.local_dir)))
         again = run_study(self.study, "--output-dir", directory, "--workers", "1")
-        self.assertIn("17 already done, 0 to run", again.stderr)
-        self.assertEqual(len(read_rows(directory)), 17)
+        self.assertIn("18 already done, 0 to run", again.stderr)
+        self.assertEqual(len(read_rows(directory)), 18)
+
+    def test_sigint_stops_between_rows_and_the_same_command_runs_only_the_missing_tasks(self):
+        study = self.write("interrupted.yaml", CLUSTER_STUDY.replace("cluster_test_study", "interrupted_study"))
+        directory = os.path.join(self.directory, "interrupted")
+        rows_path = os.path.join(directory, "rows.jsonl")
+        runner = subprocess.Popen(study_command(study, "--output-dir", directory, "--workers", "1"),
+                                  stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
+        deadline = time.monotonic() + RUN_LIMIT
+        while time.monotonic() < deadline and runner.poll() is None:
+            if os.path.exists(rows_path) and sum(1 for _ in open(rows_path)) >= 3:
+                break
+            time.sleep(0.05)
+        self.assertIsNone(runner.poll(), "the study ended before it could be interrupted")
+        runner.send_signal(signal.SIGINT)
+        _, stderr = runner.communicate(timeout=60)
+        self.assertEqual(runner.returncode, 130, stderr)
+        self.assertIn("the same command resumes", stderr)
+        done = len(read_rows(directory))
+        self.assertLess(done, 14)
+        again = run_study(study, "--output-dir", directory, "--workers", "1")
+        self.assertEqual(again.returncode, 0, again.stderr)
+        self.assertIn("14 tasks, %d already done, %d to run" % (done, 14 - done), again.stderr)
+        rows = read_rows(directory)
+        self.assertEqual(sorted(r["task_id"] for r in rows), sorted({r["task_id"] for r in rows}))
+        self.assertEqual(len(rows), 14)
 
     def test_the_report_from_the_rows_equals_the_one_written_at_the_end(self):
         page = os.path.join(self.directory, "from_rows.md")
@@ -295,9 +320,9 @@ experiments:
             self.assertIn("on 2 Dask worker(s) at tcp://127.0.0.1", stderr)
             rows = read_rows(os.path.join(directory, "out"))
             ids = [r["task_id"] for r in rows]
-            self.assertLess(killed_at, 13)
-            self.assertEqual(len(ids), 13)  # 1 reference + 12 measurements, each exactly once
-            self.assertEqual(len(set(ids)), 13)
+            self.assertLess(killed_at, 14)
+            self.assertEqual(len(ids), 14)  # a reference, its check, 12 measurements: each exactly once
+            self.assertEqual(len(set(ids)), 14)
             self.assertEqual({r["worker"] for r in rows[killed_at:]}, {"w1"})  # after the kill, only w1 works
             self.assertEqual(errors_by_task(rows), errors_by_task(read_rows(os.path.join(directory, "local"))))
         finally:

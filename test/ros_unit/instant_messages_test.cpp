@@ -1,4 +1,4 @@
-// No allocation per step or per publish instant (issue 13): the node's publishing path — steps of
+// No allocation per step or per publish instant: the node's publishing path — steps of
 // the default scene (its dopri5 shadow reference included), the messages of each instant filled
 // in place (InstantMessages, with the accuracy guard's check) and written to the bag's ring
 // (BagRecorder::write) — is run with a replaced global operator new that counts the allocations

@@ -176,7 +176,7 @@ TEST(AccuracyGuardScene, ReadsLimitsAndOffAndRefusesBadOnesNamingTheKey) {
 }
 
 /// jackknife_whirl with a 2 cm wheelbase, run with rk4 at the scene's own step (1 ms): a new
-/// user's "short cart" whose energy ends 92 % low (the report; reproduced by this run).
+/// user's "short cart" whose energy ends 92 % low.
 Scene short_wheelbase_whirl() {
   std::string text = read_file(scene_path("jackknife_whirl"));
   text = replaced_once(text, "wheelbase: 1.05 ", "wheelbase: 0.02 ");

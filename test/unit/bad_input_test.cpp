@@ -1,4 +1,4 @@
-// Bad input loses nothing (issue 7; docs/hard_cases.md §8–§9):
+// Bad input loses nothing (docs/hard_cases.md §8–§9):
 //  - torque commands NaN, ±Inf are refused with std::invalid_argument and the command in force
 //    stays; an absurd finite torque (1e300 N·m) makes the step fail with a StepError that leaves the
 //    state untouched; a flood of 1e5 commands (10 kHz for 10 s of 1 kHz steps) keeps memory flat and

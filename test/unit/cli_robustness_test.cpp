@@ -1,4 +1,4 @@
-// cart_simulate on the inputs that used to abort, hang or freeze (issue 17), and its self-help:
+// cart_simulate on the inputs most likely to abort, hang or freeze, and its self-help:
 // every run ends with exit 0 and its last row at t0 + T, or exit 2/3/4 with a message naming the
 // problem. Each run is bounded by `timeout` so that a regression to a hang fails instead of
 // stalling the suite.

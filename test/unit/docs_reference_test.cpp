@@ -1,6 +1,7 @@
 // The user documentation against the code it describes: the CLI page shows exactly what
 // `cart_simulate --help` prints, every registered integrator is documented, every relative link
-// of README.md and docs/*.md reaches a file, and the README stays a short front door.
+// of README.md and docs/*.md reaches a file, no page or source tells the development history, and
+// the README stays a short front door.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -91,6 +92,26 @@ TEST(DocsReference, EveryRelativeLinkReachesAFile) {
     }
   }
   EXPECT_GT(links, 20) << "the link pattern found too few links to be checking anything";
+}
+
+TEST(DocsReference, NoSourceOrPageTellsTheDevelopmentHistory) {
+  // History belongs in CHANGELOG.md and the commit messages; code, tests and docs state the
+  // behaviour they implement or check.
+  const std::regex history(R"((\b[Ii]ssues? [0-9]+|\buser trial\b|\b[Rr]ound [0-9]\b|\blate rerun\b))");
+  int files = 0;
+  for (const char* part : {"src", "include", "test", "scripts", "checks", "bench", "launch", "config", "docs"}) {
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(kSourceDirectory + "/" + part)) {
+      if (!entry.is_regular_file() || entry.path().extension() == ".png" || entry.path().extension() == ".jsonl") continue;
+      ++files;
+      const std::string text = read_file(entry.path().string());
+      std::smatch found;
+      EXPECT_FALSE(std::regex_search(text, found, history))
+          << entry.path().string() << " tells the development history: '" << found.str() << "'";
+    }
+  }
+  const std::string readme = read_file(kSourceDirectory + "/README.md");
+  EXPECT_FALSE(std::regex_search(readme, history)) << "README.md tells the development history";
+  EXPECT_GT(files, 100);
 }
 
 TEST(DocsReference, TheReadmeIsAFrontDoorOfAtMost25KB) {

@@ -177,7 +177,7 @@ TEST(CarriedState, SteeringAngleStaysReducedAndTheReportedAngleUnwrapped) {
 }
 
 TEST(StageSolve, NeedsFewIterationsFromExtrapolatedStartingValues) {
-  // Issue 11 aims at about 4 iterations a step; measured 4.3 (birkhoff2), 6.2 (gauss6), 5.5 (gauss8) with
+  // About 4 iterations a step is the aim; measured 4.3 (birkhoff2), 6.2 (gauss6), 5.5 (gauss8) with
   // the Jacobian kept across steps. Iteration counts are deterministic; the bound guards against a
   // regression of the starting values (an explicit start needs 7–9 at these steps).
   const Scene scene = load("jackknife_whirl");

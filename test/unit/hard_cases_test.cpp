@@ -1,4 +1,4 @@
-// Numerically hard cases (issue 7; decisions and measured numbers in docs/hard_cases.md), run for
+// Numerically hard cases (decisions and measured numbers in docs/hard_cases.md), run for
 // every integrator in both Birkhoffian representations where it applies:
 //  §1 the paper's special case at its singularity χ = t = π: a clear stop naming the singular time;
 //  §2 jackknife and whirl: χ through ±π/2 and whole turns, no spurious singularity, invariants kept;

@@ -1,4 +1,4 @@
-// The install space works (issue 17): checks/test_install.sh installs this built workspace into a
+// The install space works: checks/test_install.sh installs this built workspace into a
 // temporary DESTDIR and runs cart_simulate, cart_sim --version, rospack, rosmsg and a 2 s
 // `roslaunch birkhoff_cart sim.launch` from there, in an environment without the devel space or
 // the source tree (about 15 s). Before the libraries had install rules, the installed

@@ -178,7 +178,7 @@ TEST(KSymplecticity, Birkhoff4PreservesTheStructureOnEverySystem) {
 }
 
 TEST(KSymplecticity, GaussMembersPreserveTheStructureOnEverySystem) {
-  // Issue 11: a defect ≤ 1e-13 on the Λ = 0 systems.
+  // A defect ≤ 1e-13 on the Λ = 0 systems.
   expect_k_symplectic_on_all_systems(GaussCollocation<2>{}, 1e-13);
   expect_k_symplectic_on_all_systems(GaussCollocation<3>{}, 1e-13);
   expect_k_symplectic_on_all_systems(GaussCollocation<4>{}, 1e-13);

@@ -1,6 +1,6 @@
 // A one-hour simulated run (3.6e6 steps of 1 ms) of the driven default scene (drive torque ramp,
 // rolling resistance, air drag, cosine steering torque, hinge damping) with birkhoff2 in both
-// Birkhoffian representations (issue 7; docs/hard_cases.md §7). The paper's form carries
+// Birkhoffian representations (docs/hard_cases.md §7). The paper's form carries
 // K = e^{t}J: e^{3600} overflows a double (checked below), so the run only stays finite because the
 // structure epoch tₑ is moved to every step's start (cart_birkhoffian.h). Checked: every state
 // finite, the run reaches t = 3600 s exactly, the energy and p2 balances (docs eqs. (3.7), (3.8))

@@ -58,7 +58,7 @@ TEST(StepSchedule, EndOffTheGridGetsOneShorterFinalStep) {
 }
 
 TEST(StepSchedule, ASliverIsMergedIntoTheStepBefore) {
-  // T = 4.6960000000005 s at h = 1 ms from t0 = 1 s (issue 17 defect 1): 5e-13 s past the grid.
+  // T = 4.6960000000005 s at h = 1 ms from t0 = 1 s : 5e-13 s past the grid.
   const StepSchedule s = plan_steps(1.0, 4.6960000000005, 1e-3);
   EXPECT_EQ(s.whole_steps, 4695u);
   EXPECT_TRUE(s.final_step);
@@ -91,7 +91,7 @@ TEST(StepSchedule, RandomRunsEndExactlyAtTheirEnd) {
 }
 
 TEST(StepSchedule, SimulationFollowsThePlanOntoTheEndTime) {
-  // The two runs of issue 17 that aborted cart_simulate: t0 = 1000 s, T = 0.051 s; t0 = 1 s,
+  // Two runs on which the CLI and the schedule once disagreed: t0 = 1000 s, T = 0.051 s; t0 = 1 s,
   // T = 4.6960000000005 s (shortened to its last 50 ms by starting at 5.646 s).
   const std::pair<double, double> runs[] = {{1000.0, 0.051}, {5.646, 4.6960000000005 + 1.0 - 5.646}};
   for (const auto& [t0, duration] : runs) {
@@ -114,7 +114,7 @@ TEST(StepSchedule, SimulationFollowsThePlanOntoTheEndTime) {
 
 TEST(StepSchedule, TimesWhereTPlusHRoundsAreRefusedNamingTheKey) {
   try {
-    plan_steps(1e300, 1.0, 1e-3);  // t + h = t: time would stand still (issue 17 defect 7)
+    plan_steps(1e300, 1.0, 1e-3);  // t + h = t: time would stand still 
     FAIL() << "t0 = 1e300 accepted";
   } catch (const TimeLimitError& error) {
     EXPECT_EQ(error.key(), "initial_state.time");

@@ -1,13 +1,11 @@
-// work_precision: the reference states a scene's errors are measured against, and how far two
-// independent reference settings disagree (reference_check.csv).
+// work_precision: the reference states a scene's errors are measured against, and the second
+// setting each is checked against (the study compares the two at every checkpoint).
 //
 //  - jackknife_whirl (free cart): Boost.Odeint in extended precision (long double, 64-bit
 //    mantissa, ε = 1.1e-19) on the same right-hand side instantiated for S = long double:
 //    controlled runge_kutta_fehlberg78 at tolerance 1e-18 (the reference) against rkf78 at 1e-17
-//    (the second setting it must agree with), bulirsch_stoer at 1e-18 (an independent method)
-//    and our dopri5 at 1e-13 (the former reference), compared at every checkpoint. Computed
-//    once for the longest horizon; the shorter one takes its prefix.
-//  - the short forced scenes: our dopri5 at 1e-13 against 1e-12 (double), as before.
+//    (the second setting it must agree with), compared at every checkpoint.
+//  - the short forced scenes: our dopri5 at 1e-13 against 1e-12 (double).
 //  - paper_special: the closed form.
 #pragma once
 
@@ -99,92 +97,6 @@ inline ReferenceRun dopri5_run(const BenchScene& bench, double tolerance) {
   run.wall = wall_seconds() - w0;
   run.rhs_evaluations = sim.statistics().rhs_evaluations;
   return run;
-}
-
-/// Writes one reference_check.csv row per (check run, checkpoint): its distance from the reference.
-inline void write_reference_check(std::FILE* check, const BenchScene& bench, const ReferenceRun& reference,
-                                  const ReferenceRun& other) {
-  for (std::size_t j = 0; j < bench.checkpoint_times.size(); ++j) {
-    const CartState& a = reference.states[j];
-    const CartState& b = other.states[j];
-    std::fprintf(check, "%s,%s,%s,%.9g,%.3e,%.3e,%.3e,%llu,%.2f,%llu,%.2f\n", bench.label.c_str(),
-                 reference.name.c_str(), other.name.c_str(), bench.checkpoint_times[j], position_distance(a, b),
-                 std::abs(heading_difference(a, b)), std::abs(a.arc_length - b.arc_length),
-                 static_cast<unsigned long long>(reference.rhs_evaluations), reference.wall,
-                 static_cast<unsigned long long>(other.rhs_evaluations), other.wall);
-  }
-  std::fflush(check);
-}
-
-inline void write_reference_check_header(std::FILE* check) {
-  std::fprintf(check,
-               "scene,reference,check,t,position_difference_m,heading_difference_rad,arc_length_difference_m,"
-               "reference_rhs_evaluations,reference_wall_s,check_rhs_evaluations,check_wall_s\n");
-}
-
-/// A reference trajectory with the runs that check it, at a list of times from the start [s].
-struct ReferenceSet {
-  std::vector<double> times;
-  ReferenceRun reference;
-  std::vector<ReferenceRun> checks;  ///< checks.front() is the setting the reference must agree with
-};
-
-/// jackknife_whirl's reference (see the top of this file) at `times` (from the start [s]); the
-/// scenes that share its initial state and differ only in duration take their prefix.
-inline ReferenceSet extended_precision_reference(const BenchScene& longest, const std::vector<double>& times) {
-  BenchScene bench = longest;
-  bench.checkpoint_times = times;
-  ReferenceSet set;
-  set.times = times;
-  set.reference = extended_precision_run(bench, "rkf78", kExtendedReferenceTolerance);
-  set.checks.push_back(extended_precision_run(bench, "rkf78", kExtendedCheckTolerance));
-  set.checks.push_back(extended_precision_run(bench, "bulirsch_stoer", kExtendedReferenceTolerance));
-  set.checks.push_back(dopri5_run(bench, kDopri5ReferenceTolerance));  // the former reference, for scale
-  return set;
-}
-
-/// The ReferenceRun restricted to bench's checkpoint times (each must be one of set.times).
-inline ReferenceRun restricted(const ReferenceSet& set, const ReferenceRun& run, const BenchScene& bench) {
-  ReferenceRun part = run;
-  part.states.clear();
-  for (double t : bench.checkpoint_times) {
-    std::size_t j = 0;
-    while (j < set.times.size() && std::abs(set.times[j] - t) > 1e-9 * t) ++j;
-    if (j == set.times.size()) throw std::logic_error("reference: no state at checkpoint " + std::to_string(t) + " s");
-    part.states.push_back(run.states[j]);
-  }
-  return part;
-}
-
-/// Fills bench.reference_states and the reference's estimated error (its distance from the
-/// first check at the end) and writes reference_check.csv rows: from `shared` (computed once for
-/// the longest horizon) when given, else our dopri5 at 1e-13 against 1e-12, or the closed form.
-inline void prepare_reference(BenchScene& bench, const ReferenceSet* shared, std::FILE* check) {
-  if (bench.analytic) {
-    bench.reference_name = "paper_analytic";
-    bench.reference_error_position = 0.0;
-    bench.reference_error_heading = 0.0;
-    std::fprintf(check, "%s,paper_analytic,exact,%.9g,0,0,0,0,0,0,0\n", bench.label.c_str(), bench.scene.duration);
-    return;
-  }
-  ReferenceRun reference;
-  std::vector<ReferenceRun> checks;
-  if (shared) {
-    reference = restricted(*shared, shared->reference, bench);
-    for (const ReferenceRun& other : shared->checks) checks.push_back(restricted(*shared, other, bench));
-  } else {
-    reference = dopri5_run(bench, kDopri5ReferenceTolerance);
-    checks.push_back(dopri5_run(bench, kDopri5ReferenceCheckTolerance));
-  }
-  bench.reference_states = reference.states;
-  bench.reference_name = reference.name;
-  const std::size_t last = bench.checkpoint_times.size() - 1;
-  const ReferenceRun& estimate = checks.front();
-  bench.reference_error_position = position_distance(reference.states[last], estimate.states[last]);
-  bench.reference_error_heading = std::abs(heading_difference(reference.states[last], estimate.states[last]));
-  for (const ReferenceRun& other : checks) write_reference_check(check, bench, reference, other);
-  std::fprintf(stderr, "  reference %s (%.1f s wall): vs %s at the end %.2e m\n", reference.name.c_str(),
-               reference.wall, estimate.name.c_str(), bench.reference_error_position);
 }
 
 }  // namespace work_precision

@@ -6,10 +6,10 @@
 //     one run of one method, timed as the full benchmark times it (measurement.h), against the
 //     reference states at the checkpoints; prints ONE JSON object on stdout (the row).
 //   work_precision --reference-run --scene FILE --duration T --reference-kind extended_precision|dopri5
-//                  [--checkpoints t1,t2,...] --output REF.csv
-//     the reference states at the checkpoints (extended precision: long double rkf78 at 1e-18,
-//     checked against rkf78 at 1e-17; dopri5: 1e-13 checked against 1e-12), written with 17
-//     digits; prints one JSON object with the reference's distance from its check at each checkpoint.
+//                  [--checkpoints t1,t2,...] [--check-setting] --output REF.csv
+//     the reference states at the checkpoints (extended precision: long double rkf78 at 1e-18;
+//     dopri5: 1e-13), or with --check-setting those of the setting it is checked against (1e-17;
+//     1e-12), written with 17 digits; prints one JSON object naming the run.
 // Checkpoints are times from the start [s]; the last one must be the duration (added when missing).
 #pragma once
 
@@ -25,6 +25,7 @@
 #include "measurement.h"
 #include "odeint_peers.h"
 #include "ours.h"
+#include "output.h"
 #include "reference.h"
 
 namespace birkhoff_cart {
@@ -41,6 +42,7 @@ struct SingleTask {
   std::vector<double> checkpoints;          ///< from the start [s]
   int repetitions = 3;
   bool analytic = false;
+  bool check_setting = false;  ///< --reference-run: the second setting the reference is checked against
 };
 
 inline double positive_number(const std::string& option, const std::string& text) {
@@ -75,6 +77,7 @@ inline SingleTask parse_single_task(int argc, char** argv) {
     else if (arg == "--simulator-step") task.simulator_step = positive_number(arg, value());
     else if (arg == "--reference-file") task.reference_file = value();
     else if (arg == "--analytic-reference") task.analytic = true;
+    else if (arg == "--check-setting") task.check_setting = true;
     else if (arg == "--reference-kind") task.reference_kind = value();
     else if (arg == "--output") task.output = value();
     else if (arg == "--repetitions") {
@@ -89,6 +92,7 @@ inline SingleTask parse_single_task(int argc, char** argv) {
       throw std::invalid_argument("unknown argument '" + arg + "'");
     }
   }
+  if (task.mode.empty()) throw std::invalid_argument("give --measure or --reference-run (one task of a study)");
   if (task.scene_file.empty()) throw std::invalid_argument("--scene FILE is required");
   if (!std::isfinite(task.duration)) throw std::invalid_argument("--duration T is required");
   if (task.checkpoints.empty() || std::abs(task.checkpoints.back() - task.duration) > 1e-12 * task.duration) {
@@ -198,29 +202,21 @@ inline std::vector<CartState> read_reference_file(const std::string& path, const
   return chosen;
 }
 
-/// --reference-run: computes and writes the reference, prints its check.
+/// --reference-run: computes and writes the reference (or, with --check-setting, the second
+/// setting it is checked against; the study runs both as tasks of their own, in parallel, and
+/// compares their files).
 inline int run_reference_task(const SingleTask& task) {
   BenchScene bench = single_task_scene(task);
-  ReferenceRun reference, check;
+  ReferenceRun run;
   if (task.reference_kind == "extended_precision") {
-    reference = extended_precision_run(bench, "rkf78", kExtendedReferenceTolerance);
-    check = extended_precision_run(bench, "rkf78", kExtendedCheckTolerance);
+    run = extended_precision_run(bench, "rkf78", task.check_setting ? kExtendedCheckTolerance : kExtendedReferenceTolerance);
   } else {
-    reference = dopri5_run(bench, kDopri5ReferenceTolerance);
-    check = dopri5_run(bench, kDopri5ReferenceCheckTolerance);
+    run = dopri5_run(bench, task.check_setting ? kDopri5ReferenceCheckTolerance : kDopri5ReferenceTolerance);
   }
-  write_reference_file(task.output, bench, reference);
-  std::string distances;
-  for (std::size_t j = 0; j < bench.checkpoint_times.size(); ++j) {
-    if (j) distances += ",";
-    distances += "[" + json_number(bench.checkpoint_times[j]) + "," +
-                 json_number(position_distance(reference.states[j], check.states[j])) + "]";
-  }
-  std::printf("{\"reference\":%s,\"check\":%s,\"reference_rhs_evaluations\":%llu,\"reference_wall_s\":%s,"
-              "\"check_position_difference_m\":[%s]}\n",
-              json_string(reference.name).c_str(), json_string(check.name).c_str(),
-              static_cast<unsigned long long>(reference.rhs_evaluations), json_number(reference.wall).c_str(),
-              distances.c_str());
+  write_reference_file(task.output, bench, run);
+  std::printf("{\"reference\":%s,\"setting\":%s,\"rhs_evaluations\":%llu,\"wall_s\":%s}\n",
+              json_string(run.name).c_str(), task.check_setting ? "\"check\"" : "\"reference\"",
+              static_cast<unsigned long long>(run.rhs_evaluations), json_number(run.wall).c_str());
   return 0;
 }
 

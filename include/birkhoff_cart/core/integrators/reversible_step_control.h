@@ -151,7 +151,7 @@ class ReversibleStepControl {
 
  private:
   /// hₙ = ε/ρₙ₊½: a function of ρₙ₊½ alone, so −ε retraces +ε (B.42). (A cap h_max was tried: where
-  /// it binds, h stops scaling with ε and the pilots' error model breaks — a user trial found runs 3×
+  /// it binds, h stops scaling with ε and the pilots' error model breaks — runs ended 3×
   /// over their tolerance with max_step 5 ms; σ ≥ σ₀ bounds h by ε/σ₀ instead.)
   double step_for(double epsilon, double rho_half) const { return epsilon / rho_half; }
 
