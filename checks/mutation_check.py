@@ -4,6 +4,12 @@ of the repository, builds only the test targets that should notice, runs those t
 (exit status 1) if any mutation survives — i.e. if every one of its tests still passes.
 
 Usage: /usr/bin/python3 checks/mutation_check.py [--scratch DIR] [--only NAME ...] [--list] [--check-targets]
+                                                 [--rotate K] [--junit FILE]
+
+--rotate K applies K mutations chosen from the list by the commit being tested (its hash picks where
+in the list they start): each commit checks a different slice, the same commit always the same one,
+and the run names the --only command that repeats it. scripts/run_tests.sh runs `--rotate 2
+--junit ...` (each mutation a test case: killed passes); the whole list is the command without options.
 
 The working tree is never modified: the tracked files are copied (git ls-files) to
 DIR/src/birkhoff_cart (default: $TMPDIR/birkhoff_cart_mutation), configured once with CMake
@@ -13,6 +19,7 @@ meaningless and it stops. A mutation whose target text is not found exactly once
 code moved: update the list), not a kill. Repeated runs reuse the scratch build (ccache, make).
 """
 import argparse
+import hashlib
 import os
 import pathlib
 import shutil
@@ -231,6 +238,31 @@ def check_targets(mutations, root=REPO) -> int:
     return 1 if stale else 0
 
 
+def rotation(mutations, count, root=REPO):
+    """`count` consecutive mutations (cyclically) starting where HEAD's commit hash points."""
+    status, head = run(["git", "-C", str(root), "rev-parse", "HEAD"])
+    key = head.strip() if status == 0 else "no-commit"
+    start = int(hashlib.sha256(key.encode()).hexdigest(), 16) % len(mutations)
+    count = min(count, len(mutations))
+    return [mutations[(start + i) % len(mutations)] for i in range(count)], key[:12]
+
+
+def write_junit(path: pathlib.Path, cases):
+    """cases: [(name, seconds, failure text or None)] as one JUnit test suite."""
+    from xml.sax.saxutils import escape, quoteattr
+    failures = sum(1 for _, _, failure in cases if failure)
+    lines = ['<?xml version="1.0" encoding="UTF-8"?>',
+             f'<testsuite name="mutation_check" tests="{len(cases)}" failures="{failures}" errors="0">']
+    for name, seconds, failure in cases:
+        lines.append(f'  <testcase classname="mutation_check" name={quoteattr(name)} time="{seconds:.0f}">')
+        if failure:
+            lines.append(f'    <failure message={quoteattr(failure)}>{escape(failure)}</failure>')
+        lines.append("  </testcase>")
+    lines.append("</testsuite>")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text("\n".join(lines) + "\n")
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scratch", type=pathlib.Path,
@@ -242,7 +274,13 @@ def main() -> int:
                              "occurs exactly once in the working tree (CI runs this on every change)")
     parser.add_argument("--root", type=pathlib.Path, default=REPO,
                         help="with --check-targets: the source tree to check (default: this repository)")
+    parser.add_argument("--rotate", type=int, metavar="K",
+                        help="apply K mutations chosen by the commit hash instead of the whole list")
+    parser.add_argument("--junit", type=pathlib.Path, metavar="FILE",
+                        help="also write each mutation as a JUnit test case (killed = passed)")
     arguments = parser.parse_args()
+    if arguments.rotate is not None and (arguments.rotate < 1 or arguments.only):
+        parser.error("--rotate takes a positive count and excludes --only")
     if arguments.list:
         for mutation in MUTATIONS:
             tests = ", ".join(target for target, _ in mutation.tests)
@@ -254,6 +292,12 @@ def main() -> int:
     unknown = set(arguments.only or []) - {m.name for m in MUTATIONS}
     if unknown:
         sys.exit(f"mutation_check: unknown mutation(s) {', '.join(sorted(unknown))}; --list shows them")
+    if arguments.rotate is not None:
+        chosen, commit = rotation(MUTATIONS, arguments.rotate)
+        names = " ".join(m.name for m in chosen)
+        print(f"mutation_check: {len(chosen)} of {len(MUTATIONS)} mutations for commit {commit}; "
+              f"repeat with --only {names}", flush=True)
+    cases = []  # for --junit
 
     started = time.time()
     scratch = arguments.scratch.resolve()
@@ -281,7 +325,10 @@ def main() -> int:
     all_tests = sorted({test for mutation in chosen for test in mutation.tests})
     built, failing, _ = build_and_run(build, all_tests, log)
     if not built or failing:
-        print("mutation_check: the UNMUTATED baseline does not pass: " + (", ".join(failing) or "build failed"))
+        why = "the UNMUTATED baseline does not pass: " + (", ".join(failing) or "build failed")
+        print("mutation_check: " + why)
+        if arguments.junit:
+            write_junit(arguments.junit, [("baseline", time.time() - started, why + f" (log {log.name})")])
         return 1
     print(f"baseline: {len(all_tests)} test runs pass ({time.time() - started:.0f} s)", flush=True)
 
@@ -293,6 +340,7 @@ def main() -> int:
         if occurrences != 1:
             broken.append(mutation.name)
             print(f"ERROR    {mutation.name}: its target text occurs {occurrences} times in {mutation.path}")
+            cases.append((mutation.name, 0.0, f"target text occurs {occurrences} times in {mutation.path}"))
             continue
         began = time.time()
         try:
@@ -304,16 +352,21 @@ def main() -> int:
         if not built:
             broken.append(mutation.name)
             print(f"ERROR    {mutation.name}: the mutated source does not build ({seconds:.0f} s; see the log)")
+            cases.append((mutation.name, seconds, f"the mutated source does not build (log {log.name})"))
         elif failing:
             killed.append(mutation.name)
             print(f"killed   {mutation.name} ({mutation.why}) by {'; '.join(failing)} ({seconds:.0f} s)", flush=True)
+            cases.append((mutation.name, seconds, None))
         else:
             survived.append(mutation.name)
             print(f"SURVIVED {mutation.name} ({mutation.why}): {'; '.join(passing)} all pass ({seconds:.0f} s)",
                   flush=True)
-    # Rebuild the pristine tests so the scratch build matches the source again.
-    build_and_run(build, all_tests, log)
+            cases.append((mutation.name, seconds, f"SURVIVED: {mutation.why}; {'; '.join(passing)} all pass"))
+    # The scratch sources are pristine again and newer than the mutated objects: the next run's
+    # baseline rebuilds what a mutation touched.
     total = len(chosen)
+    if arguments.junit:
+        write_junit(arguments.junit, cases)
     print(f"{len(killed)} of {total} mutations killed, {len(survived)} survived, {len(broken)} errors "
           f"({time.time() - started:.0f} s)")
     return 0 if len(killed) == total else 1

@@ -10,30 +10,39 @@
 # stderr; the logs are also searched for a report. Every run first proves that on small programs
 # with one defect each (--self-check).
 #
-# One suppression, by name (checks/sanitize/lsan.supp): the rosbag::Bag that BagRecorder::close()
-# lets go on purpose when closing it failed (its destructor would throw; see bag_recorder.cpp).
+# No suppressions: every leak report fails the run.
 # bad_input_test's memory-growth check runs with a 1 MiB ASan quarantine (quarantine_size_mb=1):
 # with the default 256 MiB quarantine every freed block stays resident and the flood would look
 # like growth.
 #
-# Usage: checks/sanitize.sh [--compiler gcc|clang] [--no-build] [--self-check]
+# Usage: checks/sanitize.sh [--compiler gcc|clang] [--no-build] [--self-check] [--ros-free]
+#                           [--jobs N] [--junit FILE]
 #        (default gcc, the project's compiler; with clang the build stops at clang-only warnings,
-#        since the package builds with -Werror; --self-check only proves the report detection, 3 s)
-# Prints "N passed, N failed" and the wall and CPU time; exits non-zero on any failure or report.
-# Measured on the shared 2-core machine (docs/developing.md): from scratch 41 min 39 s of wall time
-# (1868 s CPU; the build ~29 min of it, niced beside other builds); with a warm ccache and few changed
-# files 16 min 9 s (build 155 s, the 45 runs 814 s, one at a time).
+#        since the package builds with -Werror; --self-check only proves the report detection, 3 s;
+#        --ros-free builds and runs only the ROS-free unit tests (test/unit: core, integrators,
+#        scenes, the CLI) but the two long-horizon ones, and cart_simulate on the shipped scenes:
+#        the step scripts/run_tests.sh runs; --jobs runs N tests at once (default 2, the cores of
+#        the CI machine); --junit writes every run as a test case of a JUnit XML file, which the
+#        test count of scripts/run_tests.sh includes)
+# Prints "N passed, N failed" and the wall time of the build and of the runs and the CPU time;
+# exits non-zero on any failure or report.
 set -uo pipefail
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 export PATH="/usr/bin:/bin:$PATH"
 compiler=gcc
 build=true
 self_check_only=false
+ros_free=false
+parallel=2
+junit=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --compiler) compiler="${2:-}"; shift 2 ;;
     --no-build) build=false; shift ;;  # run what the last build left (a missing test fails)
     --self-check) self_check_only=true; build=false; shift ;;  # only prove that reports are caught
+    --ros-free) ros_free=true; shift ;;  # test/unit and the CLI only: no roscpp, no rosbag
+    --jobs) parallel="${2:-}"; [[ "$parallel" =~ ^[1-9][0-9]*$ ]] || { echo "sanitize: --jobs needs a positive count" >&2; exit 2; }; shift 2 ;;
+    --junit) junit="${2:-}"; [ -n "$junit" ] || { echo "sanitize: --junit needs a file name" >&2; exit 2; }; shift 2 ;;
     *) echo "sanitize: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
@@ -52,10 +61,21 @@ flags="-fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=al
 [ "$compiler" = gcc ] && flags="$flags -Wno-maybe-uninitialized"
 
 unit_tests=()
-for source in "$repo"/test/unit/*_test.cpp "$repo"/test/ros_unit/*_test.cpp; do
-  test="$(basename "$source" .cpp)"
-  # install_space_test installs a fully built workspace (cart_sim too): not a memory check.
-  [ "$test" = install_space_test ] || unit_tests+=("$test")
+sources=("$repo"/test/unit/*_test.cpp)
+$ros_free || sources+=("$repo"/test/ros_unit/*_test.cpp)
+# The longest runs first, so that the parallel runs end together.
+longest_first=(long_horizon_test long_run_test random_hard_cases_test hard_cases_test independent_model_test)
+# install_space_test installs a fully built workspace (cart_sim too): not a memory check. The
+# --ros-free step leaves out the two long-horizon tests: they run the integrators' code paths that
+# the contract, collocation and hard-case tests run, for 10^4–10^5 steps more (about 400 s under
+# ASan on the 2-core machine); the full pass runs them.
+left_out=(install_space_test)
+$ros_free && left_out+=(long_horizon_test long_run_test)
+for test in "${longest_first[@]}" $(for source in "${sources[@]}"; do basename "$source" .cpp; done); do
+  [[ " ${left_out[*]} ${unit_tests[*]} " == *" $test "* ]] && continue
+  [ -f "$repo/test/unit/$test.cpp" ] || [ -f "$repo/test/ros_unit/$test.cpp" ] || continue
+  [ -f "$repo/test/ros_unit/$test.cpp" ] && $ros_free && continue
+  unit_tests+=("$test")
 done
 
 $build && echo "== build ($compiler: $flags) in $workspace"
@@ -78,9 +98,36 @@ if $build; then (
 ) > "$workspace/build.log" 2>&1 || build_status=$?; fi
 set -u
 build_seconds=$((SECONDS - build_start))
+junit_cases=()  # "<name> <seconds> <ok|FAIL> <log>" per run, for --junit
+write_junit() {  # one JUnit XML file, a test case per run, the failure text from its log
+  [ -n "$junit" ] || return 0
+  mkdir -p "$(dirname "$junit")"
+  /usr/bin/python3 - "$junit" "${junit_cases[@]}" <<'JUNIT'
+import sys
+from xml.sax.saxutils import escape, quoteattr
+path, cases = sys.argv[1], [c.split(" ", 3) for c in sys.argv[2:]]
+failures = sum(1 for c in cases if c[2] != "ok")
+lines = ['<?xml version="1.0" encoding="UTF-8"?>',
+         f'<testsuite name="sanitize" tests="{len(cases)}" failures="{failures}" errors="0">']
+for name, seconds, verdict, log in cases:
+    lines.append(f'  <testcase classname="sanitize" name={quoteattr(name)} time="{seconds}">')
+    if verdict != "ok":
+        try:
+            text = open(log, errors="replace").read()[-4000:]
+        except OSError:
+            text = "no log"
+        lines.append(f'    <failure message={quoteattr("sanitizer report or failure: " + log)}>{escape(text)}</failure>')
+    lines.append("  </testcase>")
+lines.append("</testsuite>")
+open(path, "w").write("\n".join(lines) + "\n")
+JUNIT
+}
+
 if [ "$build_status" -ne 0 ]; then
   grep -E "error|Error" "$workspace/build.log" | head -n 30
   echo "sanitize: build failed (log: $workspace/build.log)"
+  junit_cases+=("build 0 FAIL $workspace/build.log")
+  write_junit
   echo "0 passed, 1 failed"
   exit 1
 fi
@@ -91,17 +138,10 @@ logs="$workspace/logs"
 reports="$logs/reports"  # every sanitizer report of every process, children included
 rm -rf "$logs"
 mkdir -p "$reports"
-suppressions="$repo/checks/sanitize/lsan.supp"
 common="abort_on_error=0:halt_on_error=1:detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1"
-export LSAN_OPTIONS="suppressions=$suppressions:print_suppressions=0"
+unset LSAN_OPTIONS  # no suppressions
 passed=0
 failed=0
-# Exactly one suppression, the one named above: anything more must be argued here first.
-entries="$(grep -cvE '^[[:space:]]*(#|$)' "$suppressions")"
-if [ "$entries" != 1 ] || ! grep -qx 'leak:birkhoff_cart::BagRecorder::close' "$suppressions"; then
-  echo "sanitize: FAIL $suppressions must hold exactly the one entry leak:birkhoff_cart::BagRecorder::close (has $entries)"
-  failed=$((failed + 1))
-fi
 run() {  # run NAME TIMEOUT ASAN_EXTRA COMMAND...: one sanitized run, judged by exit status and reports
   local name="$1" limit="$2" extra="$3"
   shift 3
@@ -128,10 +168,35 @@ run() {  # run NAME TIMEOUT ASAN_EXTRA COMMAND...: one sanitized run, judged by 
   fi
 }
 
+launched=()  # runs started by launch, in order, collected by collect
+launch() {  # launch NAME TIMEOUT ASAN_EXTRA COMMAND...: run in the background, at most $parallel at once
+  while [ "$(jobs -rp | wc -l)" -ge "$parallel" ]; do wait -n; done
+  ( run "$@" > "$logs/$1.verdict" 2>&1 ) &
+  launched+=("$1")
+}
+collect() {  # waits for the launched runs; prints and counts their verdicts in launch order
+  wait
+  local name verdict seconds
+  for name in "${launched[@]}"; do
+    verdict="$(cat "$logs/$name.verdict")"
+    echo "$verdict"
+    seconds="$(sed -nE 's/^sanitize: (ok  |FAIL) [^ ]+ \((exit [0-9]+, )?([0-9]+) s.*/\3/p' <<< "$verdict" | head -n 1)"
+    if [[ "$verdict" == "sanitize: ok   "* ]]; then
+      passed=$((passed + 1))
+      junit_cases+=("$name ${seconds:-0} ok $logs/$name.log")
+    else
+      failed=$((failed + 1))
+      junit_cases+=("$name ${seconds:-0} FAIL $logs/$name.log")
+    fi
+  done
+  launched=()
+}
+
 {  # every run starts with it (3 s): a check that cannot fail proves nothing
   # The net itself: small programs with the same flags, each with one defect, must each fail, also
-  # when the defect is in a child whose parent exits 0 (ASan and LSan reports go to log_path files);
-  # the suppressed leak must pass. Exits non-zero if a defect went unnoticed.
+  # when the defect is in a child whose parent exits 0 (ASan and LSan reports go to log_path files),
+  # and a clean run of the same program must pass. Exits non-zero if a defect went unnoticed or the
+  # clean run was judged a failure.
   # Limit, measured: GCC's libubsan beside libasan ignores log_path (its common flags are never
   # parsed as a plugin), so a UBSan report in a child is seen through the child's exit status 1
   # (halt_on_error). Every test that starts cart_simulate checks its status exactly, and
@@ -143,8 +208,6 @@ run() {  # run NAME TIMEOUT ASAN_EXTRA COMMAND...: one sanitized run, judged by 
 #include <cstdlib>
 #include <cstring>
 #include <string>
-namespace birkhoff_cart { struct BagRecorder { static void close(); }; }
-__attribute__((noinline)) void birkhoff_cart::BagRecorder::close() { static char* volatile kept; kept = new char[64]; kept = nullptr; }
 int main(int argc, char** argv) {
   const std::string what = argc > 1 ? argv[1] : "";
   if (what == "child") {  // the parent ignores the child's exit status: only its report tells
@@ -156,7 +219,6 @@ int main(int argc, char** argv) {
   if (what == "overflow") big = big + argc;                       // UBSan: signed integer overflow
   if (what == "cast") { volatile double d = 1e19; big = static_cast<int>(d); }  // float-cast-overflow
   if (what == "leak") { static char* volatile lost; lost = new char[64]; lost = nullptr; }  // LSan
-  if (what == "suppressed") birkhoff_cart::BagRecorder::close();  // the named suppression
   delete[] heap;
   return 0;
 }
@@ -165,6 +227,9 @@ PROBE
   if ! "$cxx" -std=c++17 $flags -Wno-overflow -fsanitize=address,undefined -o "$probe/defects" \
       "$probe/defects.cpp" > "$probe/build.log" 2>&1; then
     echo "sanitize: FAIL the self-check probe did not build (log $probe/build.log)"
+    junit_cases+=("self_check 0 FAIL $probe/build.log")
+    write_junit
+    echo "0 passed, 1 failed"
     exit 1
   fi
   unnoticed=0
@@ -177,40 +242,51 @@ PROBE
       *) echo "sanitize: MISSED $defect ($how): $output"; unnoticed=$((unnoticed + 1)) ;;
     esac
   done
-  output="$(run probe_suppressed 60 "" "$probe/defects" suppressed)"
-  case "$output" in
-    *"ok   probe_"*) echo "sanitize: passed the suppressed leak in birkhoff_cart::BagRecorder::close" ;;
-    *) echo "sanitize: the named suppression did not hold: $output"; unnoticed=$((unnoticed + 1)) ;;
-  esac
-  if [ "$failed" -ne 0 ] || [ "$unnoticed" -ne 0 ]; then
+  for how in direct child; do  # no defect: must pass, or every FAIL above proves nothing
+    if [ "$how" = direct ]; then arguments=(clean); else arguments=(child clean); fi
+    output="$(run "probe_clean_$how" 60 "" "$probe/defects" "${arguments[@]}")"
+    case "$output" in
+      *"ok   probe_"*) echo "sanitize: passed the clean run ($how)" ;;
+      *) echo "sanitize: a clean run was judged a failure: $output"; unnoticed=$((unnoticed + 1)) ;;
+    esac
+  done
+  if [ "$unnoticed" -ne 0 ]; then
     echo "sanitize: self-check FAILED"
+    junit_cases+=("self_check 0 FAIL $logs/probe/build.log")
+    write_junit
     echo "0 passed, 1 failed"
     exit 1
   fi
   echo "sanitize: self-check passed"
-  $self_check_only && exit 0
+  junit_cases+=("self_check_detects_every_defect 0 ok $probe/build.log")
+  passed=$((passed + 1))
+  $self_check_only && { write_junit; exit 0; }
 }
 
-echo "== unit tests"
+echo "== unit tests ($parallel at once)${left_out[1]:+; left out: ${left_out[*]:1}}"
 for test in "${unit_tests[@]}"; do
   extra=""
   [ "$test" = bad_input_test ] && extra="quarantine_size_mb=1"
   if [ ! -x "$bin/$test" ]; then
     echo "sanitize: FAIL $test (not built)"
     failed=$((failed + 1))
+    junit_cases+=("$test 0 FAIL $workspace/build.log")
     continue
   fi
-  run "$test" 1800 "$extra" "$bin/$test"
+  launch "$test" 1800 "$extra" "$bin/$test"
 done
+collect
 
 echo "== cart_simulate on the shipped scenes"
 for scene in "$repo"/config/scenes/*.yaml; do
   name="$(basename "$scene" .yaml)"
-  run "scene_$name" 600 "" "$bin/cart_simulate" --quiet --scene "$scene" --output "$logs/$name.csv"
+  launch "scene_$name" 600 "" "$bin/cart_simulate" --quiet --scene "$scene" --output "$logs/$name.csv"
 done
+collect
 
 # Wall time of the build and of the runs, and the CPU time of everything this script started.
 echo "sanitize: build $build_seconds s, runs $((SECONDS - runs_start)) s of wall time; CPU (user, system) of the script, then of its children:"
 times
+write_junit
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

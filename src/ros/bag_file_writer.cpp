@@ -10,6 +10,13 @@
 #include <algorithm>
 #include <cerrno>
 
+// Every integer and double goes into the file as the host holds it in memory (append_u32,
+// append_value_field): right for the little-endian format only on a little-endian host. A
+// big-endian build stops here instead of writing bags that no reader can parse.
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
+              "BagFileWriter writes host-order integers into rosbag's little-endian format: "
+              "a big-endian host needs byte swaps in append_u32 and append_value_field");
+
 namespace birkhoff_cart {
 namespace {
 

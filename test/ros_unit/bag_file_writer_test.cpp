@@ -1,7 +1,7 @@
 // BagFileWriter (the node's sequential rosbag 2.0 writer): uncompressed it writes the very bytes
 // rosbag::Bag writes for the same messages (several chunks, several types, a topic whose times go
-// back); with every compression rosbag::View reads back each message, in order, without
-// reindexing; a file left without close() is unindexed; misuse and unwritable paths throw naming
+// back); with every compression rosbag's C++ reader (rosbag::View) and its Python reader
+// (rosbag.Bag) read back each message, in order, without reindexing; a file left without close() is unindexed; misuse and unwritable paths throw naming
 // the problem. No master needed; every file lives in a scratch directory removed at the end.
 #include <gtest/gtest.h>
 
@@ -124,15 +124,18 @@ TEST(BagFileWriter, UncompressedBagIsByteForByteRosbags) {
 
 class BagFileWriterCompression : public ::testing::TestWithParam<BagFileWriter::Compression> {};
 
+/// kInstants publish instants in small chunks, closed (indexed).
+void write_closed_bag(const std::string& path, BagFileWriter::Compression compression) {
+  BagFileWriter writer(path, compression, kSmallChunk);
+  for (int k = 1; k <= kInstants; ++k) write_instant(writer, k);
+  writer.close();
+}
+
 TEST_P(BagFileWriterCompression, RosbagReadsEveryMessageBackWithoutReindexing) {
   ScratchDirectory scratch;
   ASSERT_TRUE(scratch.ok());
   const std::string path = scratch.file("compressed.bag");
-  {
-    BagFileWriter writer(path, GetParam(), kSmallChunk);
-    for (int k = 1; k <= kInstants; ++k) write_instant(writer, k);
-    writer.close();
-  }
+  write_closed_bag(path, GetParam());
   rosbag::Bag bag(path, rosbag::bagmode::Read);  // throws BagUnindexedException for an unindexed bag
   rosbag::View odometry_view(bag, rosbag::TopicQuery(std::vector<std::string>{"/odom"}));
   ASSERT_EQ(odometry_view.size(), static_cast<unsigned>(kInstants));
@@ -154,6 +157,45 @@ TEST_P(BagFileWriterCompression, RosbagReadsEveryMessageBackWithoutReindexing) {
   }
   rosbag::View everything(bag);
   EXPECT_EQ(everything.size(), 5u * kInstants);
+}
+
+// rosbag's Python reader (rosbag.Bag, message classes generated from the definitions the bag
+// carries): every topic's count, the odometry values and times, each topic in time order. It
+// raises ROSBagUnindexedException for an unindexed bag and ROSBagException for a bad record.
+constexpr char kPythonReader[] = R"(import sys, rosbag
+with rosbag.Bag(sys.argv[1]) as bag:
+    counts, previous, odometry_ok, in_order = {}, {}, True, True
+    for topic, message, time in bag.read_messages():
+        counts[topic] = counts.get(topic, 0) + 1
+        in_order = in_order and previous.get(topic, time) <= time
+        previous[topic] = time
+        if topic == "/odom":
+            k = counts[topic]
+            odometry_ok = (odometry_ok and message.pose.pose.position.x == 0.01 * k
+                           and time == message.header.stamp and abs(time.to_sec() - 0.01 * k) < 1e-9
+                           and message.child_frame_id == "base_link")
+    for topic in sorted(counts):
+        print("count", topic, counts[topic])
+    print("odometry_ok", int(odometry_ok))
+    print("in_order", int(in_order))
+)";
+
+TEST_P(BagFileWriterCompression, RosbagsPythonReaderReadsEveryMessage) {
+  ScratchDirectory scratch;
+  ASSERT_TRUE(scratch.ok());
+  const std::string path = scratch.file("compressed.bag");
+  write_closed_bag(path, GetParam());
+  const std::string script = scratch.file("read_bag.py");
+  std::ofstream(script) << kPythonReader;
+  const std::string output_path = scratch.file("read_bag.out");
+  const std::string command = "/usr/bin/python3 " + script + " " + path + " > " + output_path + " 2>&1";
+  const int status = std::system(command.c_str());
+  const std::vector<char> raw = bytes_of(output_path);
+  const std::string output(raw.begin(), raw.end());
+  ASSERT_EQ(status, 0) << command << "\n" << output;
+  const std::string n = std::to_string(kInstants);
+  EXPECT_EQ(output, "count /cart_sim/integration_error " + n + "\ncount /joint_states " + n + "\ncount /odom " + n +
+                        "\ncount /steering_torque " + n + "\ncount /tf " + n + "\nodometry_ok 1\nin_order 1\n");
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryCompression, BagFileWriterCompression,
