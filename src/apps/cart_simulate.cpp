@@ -1,8 +1,9 @@
 // cart_simulate: runs a scene in batch and writes the trajectory as CSV (no ROS master needed).
 //
 //   cart_simulate --scene FILE [--integrator NAME] [--step H] [--tolerance TOL] [--duration T]
-//                 [--output-rate HZ] [--birkhoffian-form F] [--quiet]
-//                 [--on-accuracy-error fail|warn] --output FILE.csv
+//                 [--output-rate HZ] [--birkhoffian-form F] [--quiet] [--step-control C]
+//                 [--position-tolerance M] [--on-accuracy-error fail|warn] [--random-scene SEED:K]
+//                 --output FILE.csv   (also --option=value)
 //   cart_simulate --help | -h | --version
 //
 // Columns: t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,local_error_estimate (SI
@@ -30,6 +31,7 @@
 #include <exception>
 #include <map>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -58,18 +60,19 @@ constexpr double kProgressPeriod = 1.0;  // at most one progress line per this m
 const char* const kUsage =
     "usage: cart_simulate --scene FILE [--integrator NAME] [--step H] [--tolerance TOL]\n"
     "                     [--duration T] [--output-rate HZ] [--birkhoffian-form F] [--quiet]\n"
-    "                     [--step-control fixed|reversible] [--on-accuracy-error fail|warn]\n"
-    "                     [--random-scene SEED:K] --output FILE.csv\n"
+    "                     [--step-control fixed|reversible] [--position-tolerance M]\n"
+    "                     [--on-accuracy-error fail|warn] [--random-scene SEED:K] --output FILE.csv\n"
     "       cart_simulate --help | -h | --version\n"
     "  --scene FILE            scene YAML (config/scenes/*.yaml); it provides every default\n"
     "  --integrator NAME       birkhoff2, birkhoff4, birkhoff_gauss4, birkhoff_gauss6, birkhoff_gauss8,\n"
     "                          birkhoff4_suzuki, birkhoff6_kahan_li, birkhoff8_kahan_li, rk2, rk4, dopri5\n"
     "                          or midpoint (docs/integrators.md)\n"
     "  --step H                step size [s], > 0; 1/HZ must be a whole multiple of it\n"
-    "  --tolerance TOL         dopri5: absolute and relative tolerance [-], >= 10 machine epsilon (2.2e-15);\n"
-    "                          reversible step control: the position error [m] allowed at the horizon\n"
+    "  --tolerance TOL         dopri5's absolute and relative local tolerance [-], >= 10 machine epsilon\n"
+    "                          (2.2e-15); refused for the fixed-step members\n"
     "  --step-control C        fixed (steps of H) or reversible (symmetric Birkhoffian members: their own\n"
-    "                          steps for --tolerance, H is then the output step; docs/accuracy.md §4)\n"
+    "                          steps for --position-tolerance, H is then the output step; docs/accuracy.md §4)\n"
+    "  --position-tolerance M  reversible step control: the position error [m] allowed at the horizon\n"
     "  --duration T            simulated time after the start [s], > 0\n"
     "  --output-rate HZ        output rows per simulated second [Hz], > 0\n"
     "  --birkhoffian-form F    autonomous or paper\n"
@@ -81,6 +84,7 @@ const char* const kUsage =
     "                          or warn (exit 0; the summary still names the quantity)\n"
     "  --output FILE.csv       where to write t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,\n"
     "                          local_error_estimate\n"
+    "Every option also takes the form --option=value.\n"
     "The rows are at t0 + k/HZ from the start to the end, both included; when the duration is not a\n"
     "whole number of output intervals, a last row is written at the end time t0 + T itself (reached\n"
     "by one shorter final step). Scene times are limited so that t + H stays exact to ~1e-6 H\n"
@@ -117,21 +121,29 @@ bool asks_for_help(int argc, char** argv) {
 std::map<std::string, std::string> parse_arguments(int argc, char** argv) {
   static const char* const kOptions[] = {"--scene",       "--integrator",       "--step",  "--tolerance",
                                          "--duration",    "--output-rate",      "--birkhoffian-form", "--output",
-                                         "--on-accuracy-error", "--step-control", "--random-scene"};
+                                         "--on-accuracy-error", "--step-control", "--random-scene",
+                                         "--position-tolerance"};
   std::map<std::string, std::string> values;
   for (int i = 1; i < argc; ++i) {
-    const std::string option = argv[i];
+    std::string option = argv[i];
+    std::optional<std::string> attached;  // the value of --option=value
+    const std::size_t equals = option.find('=');
+    if (option.rfind("--", 0) == 0 && equals != std::string::npos) {
+      attached = option.substr(equals + 1);
+      option.resize(equals);
+    }
     if (option == "--quiet") {
+      if (attached) throw UsageError("option --quiet takes no value, got '--quiet=" + *attached + "'");
       if (values.count(option)) throw UsageError("option --quiet given twice");
       values[option] = "";
       continue;
     }
     bool known = false;
     for (const char* candidate : kOptions) known = known || option == candidate;
-    if (!known) throw UsageError("unknown argument '" + option + "'");
-    if (i + 1 >= argc) throw UsageError("option " + option + " needs a value");
+    if (!known) throw UsageError("unknown argument '" + std::string(argv[i]) + "'");
+    if (!attached && i + 1 >= argc) throw UsageError("option " + option + " needs a value");
     if (values.count(option)) throw UsageError("option " + option + " given twice");
-    values[option] = argv[++i];
+    values[option] = attached ? *attached : argv[++i];
   }
   if (!values.count("--scene")) throw UsageError("missing --scene FILE");
   if (!values.count("--output")) throw UsageError("missing --output FILE.csv");
@@ -169,16 +181,30 @@ void apply_overrides(const std::map<std::string, std::string>& arguments, Scene&
       if (text != "fixed" && text != "reversible") {
         throw UsageError("option --step-control must be 'fixed' or 'reversible', got '" + text + "'");
       }
-      // The scene's `tolerance` is dopri5's (1e-10 in the shipped scenes); as a position error in
-      // metres it would ask for ~1e7 internal steps: a tolerance must be given with the control.
-      if (text == "reversible" && scene.integrator.step_control != "reversible" && !arguments.count("--tolerance")) {
-        throw UsageError("option --step-control reversible needs --tolerance TOL (the position error [m] allowed)");
-      }
       scene.integrator.step_control = text;
     }
+    if (option == "--position-tolerance") scene.integrator.position_tolerance = parse_positive(option, text);
     if (option == "--on-accuracy-error" && text != "fail" && text != "warn") {
       throw UsageError("option --on-accuracy-error must be 'fail' or 'warn', got '" + text + "'");
     }
+  }
+  // Each tolerance means one thing and is refused where it would be ignored.
+  const birkhoff_cart::IntegratorSettings& settings = scene.integrator;
+  const bool reversible = settings.step_control == "reversible";
+  if (arguments.count("--tolerance") && settings.name != "dopri5") {
+    throw UsageError("option --tolerance is dopri5's local tolerance [-]; " + settings.name + " steps at " +
+                     (reversible ? "the reversible step control's steps: give the position error [m] with "
+                                   "--position-tolerance M"
+                                 : "--step H (fixed steps; the symmetric Birkhoffian members choose their own "
+                                   "steps for a position error with --step-control reversible --position-tolerance M)"));
+  }
+  if (arguments.count("--position-tolerance") && !reversible) {
+    throw UsageError("option --position-tolerance is the position error [m] for --step-control reversible; the run "
+                     "steps at fixed steps of --step H");
+  }
+  if (reversible && !(settings.position_tolerance > 0.0)) {
+    throw UsageError("option --step-control reversible needs --position-tolerance M (the position error [m] allowed "
+                     "at the horizon)");
   }
 }
 

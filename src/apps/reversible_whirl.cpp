@@ -54,7 +54,7 @@ Run run(const Scene& scene, double reference_x, double reference_y) {
   Run result;
   result.control = scene.integrator.step_control;
   const bool fixed = result.control == "fixed";
-  result.setting = fixed ? scene.integrator.step_size : scene.integrator.tolerance;
+  result.setting = fixed ? scene.integrator.step_size : scene.integrator.position_tolerance;
   Simulation simulation(scene);
   const double duration = scene.duration;
   const double start = cpu_seconds();
@@ -134,7 +134,7 @@ int main(int argc, char** argv) try {
   for (double tolerance : {1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8}) {
     Scene scene = whirl(member, duration);
     scene.integrator.step_control = "reversible";
-    scene.integrator.tolerance = tolerance;
+    scene.integrator.position_tolerance = tolerance;
     scene.integrator.step_size = 1.0;  // the output step
     reversible.push_back(run(scene, rx, ry));
   }

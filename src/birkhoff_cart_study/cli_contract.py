@@ -92,6 +92,7 @@ def reason_of(line):
         (r"too far from 0", "time resolution (t + h would round)"),
         (r"not a whole number of steps", "output interval not whole steps"),
         (r"dopri5 tolerance must be", "dopri5 tolerance below the floor"),
+        (r"--tolerance is dopri5's local tolerance", "--tolerance with a fixed-step member"),
         (r"shorter than .* of the step", "duration shorter than 1e-5 h"),
         (r"must not exceed the duration", "step longer than the duration"),
         (r"internal steps", "dopri5 work limit"),

@@ -145,7 +145,10 @@ def _simulate(task, row, bin_dir, scene, work_dir):
     csv = os.path.join(work_dir, "out.csv")
     command = [os.path.join(bin_dir, "cart_simulate"), "--scene", scene, "--integrator", task["method"],
                "--output", csv, "--quiet"]
-    for key, option in (("step", "--step"), ("tolerance", "--tolerance"), ("duration", "--duration"),
+    # A study's `tolerances` are dopri5's local tolerance [-], or with step_control: reversible the
+    # position error [m] the control aims at (cart_simulate's --position-tolerance).
+    tolerance_option = "--position-tolerance" if task.get("step_control") == "reversible" else "--tolerance"
+    for key, option in (("step", "--step"), ("tolerance", tolerance_option), ("duration", "--duration"),
                         ("output_rate", "--output-rate"), ("birkhoffian_form", "--birkhoffian-form"),
                         ("random_scene", "--random-scene")):
         if key in task:

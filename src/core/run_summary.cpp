@@ -18,12 +18,13 @@ std::string step_control_summary(const IntegratorSettings& settings, const StepS
   if (settings.step_control != "reversible") return "";
   char text[320];
   if (statistics.internal_steps == 0) {
-    std::snprintf(text, sizeof text, "reversible step control: tolerance %.3g m (no internal step yet)", settings.tolerance);
+    std::snprintf(text, sizeof text, "reversible step control: position tolerance %.3g m (no internal step yet)",
+                  settings.position_tolerance);
   } else {
     std::snprintf(text, sizeof text,
-                  "reversible step control: tolerance %.3g m, eps = %.4g rad (pilot order %.2g), %llu internal steps "
+                  "reversible step control: position tolerance %.3g m, eps = %.4g rad (pilot order %.2g), %llu internal steps "
                   "from %.3g s to %.3g s",
-                  settings.tolerance, statistics.control_fictive_step, statistics.control_observed_order,
+                  settings.position_tolerance, statistics.control_fictive_step, statistics.control_observed_order,
                   static_cast<unsigned long long>(statistics.internal_steps), statistics.internal_step_min,
                   statistics.internal_step_max);
   }

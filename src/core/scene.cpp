@@ -101,7 +101,7 @@ IntegratorSettings read_integrator(const SceneReader& reader, const YAML::Node& 
   reader.require_map(node, key,
                      {"name", "step_size", "tolerance", "birkhoffian_form", "max_newton_iterations",
                       "newton_tolerance", "compensated_summation", "local_error_estimate", "step_control",
-                      "tolerance_horizon"});
+                      "position_tolerance", "tolerance_horizon"});
   IntegratorSettings settings;
   settings.name = reader.choice(node, key, "name", known_integrators());
   settings.step_size = reader.required_number(node, key, "step_size", Range::kPositive);
@@ -120,8 +120,12 @@ IntegratorSettings read_integrator(const SceneReader& reader, const YAML::Node& 
   if (reader.has(node, "step_control")) {
     settings.step_control = reader.choice(node, key, "step_control", {"fixed", "reversible"});
   }
+  settings.position_tolerance =
+      reader.optional_number(node, key, "position_tolerance", Range::kPositive, settings.position_tolerance);
   settings.tolerance_horizon =
       reader.optional_number(node, key, "tolerance_horizon", Range::kPositive, settings.tolerance_horizon);
+  // One meaning per key: `tolerance` is dopri5's local tolerance [-] (kept in the shipped scenes for a
+  // switch to dopri5), `position_tolerance` the position error [m] the reversible step control aims at.
   if (settings.step_control == "reversible") {
     const std::vector<std::string> members = reversible_integrator_names();
     if (std::find(members.begin(), members.end(), settings.name) == members.end()) {
@@ -130,8 +134,17 @@ IntegratorSettings read_integrator(const SceneReader& reader, const YAML::Node& 
       reader.fail(key + ".step_control", "'reversible' is for the symmetric Birkhoffian members (" + list + "), not '" +
                                              settings.name + "'");
     }
-  } else if (reader.has(node, "tolerance_horizon")) {
-    reader.fail(key + ".tolerance_horizon", "is only for 'step_control: reversible'");
+    if (!reader.has(node, "position_tolerance")) {
+      reader.fail(key + ".position_tolerance", "is required with 'step_control: reversible': the position error [m] "
+                                               "allowed at the horizon (" + key + ".tolerance is dopri5's local "
+                                               "tolerance [-], not this)");
+    }
+  } else {
+    for (const char* reversible_only : {"position_tolerance", "tolerance_horizon"}) {
+      if (reader.has(node, reversible_only)) {
+        reader.fail(key + "." + reversible_only, "is only for 'step_control: reversible'");
+      }
+    }
   }
   return settings;
 }

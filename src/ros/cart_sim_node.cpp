@@ -189,7 +189,7 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   restart_schedule();
   const std::string step_control = simulation_->scene().integrator.step_control == "reversible"
                                        ? " (reversible step control for " +
-                                             format_seconds(simulation_->scene().integrator.tolerance) +
+                                             format_seconds(simulation_->scene().integrator.position_tolerance) +
                                              " m; h is the output step)"
                                        : "";
   ROS_INFO("cart_sim: scene '%s' (%s), integrator %s, h = %g s%s, %s mode%s, publish %g Hz, end t = %s s, frames %s -> "

@@ -135,6 +135,56 @@ TEST(CartSimulate, CommandLineOverridesTheScene) {
   std::remove(output.c_str());
 }
 
+// Every option also takes the form --option=value: the same run, byte for byte.
+TEST(CartSimulate, OptionEqualsValueIsTheSameAsOptionValue) {
+  const std::string separate = temp_path("separate.csv");
+  const std::string joined = temp_path("joined.csv");
+  const CliOutcome first = run_cli("--scene '" + scene_path("free_coast") +
+                                   "' --integrator rk4 --step 2e-3 --output-rate 50 --duration 1 --quiet --output '" +
+                                   separate + "'");
+  const CliOutcome second = run_cli("--scene='" + scene_path("free_coast") +
+                                    "' --integrator=rk4 --step=2e-3 --output-rate=50 --duration=1 --quiet --output='" +
+                                    joined + "'");
+  ASSERT_EQ(first.exit_status, 0) << first.standard_error;
+  ASSERT_EQ(second.exit_status, 0) << second.standard_error;
+  EXPECT_EQ(read_lines(separate).size(), 52u);  // the header and 51 rows
+  EXPECT_EQ(read_file(separate), read_file(joined));
+  for (const std::string& bad : {std::string(" --quiet=yes"), std::string(" --step="), std::string(" --stpe=0.01")}) {
+    const CliOutcome refused =
+        run_cli("--scene '" + scene_path("free_coast") + "' --output '" + temp_path("never.csv") + "'" + bad);
+    EXPECT_EQ(refused.exit_status, 2) << bad;
+    EXPECT_NE(refused.standard_error.find(bad == " --quiet=yes" ? "--quiet takes no value"
+                                          : bad == " --step="    ? "--step needs a finite number > 0"
+                                                                 : "unknown argument '--stpe=0.01'"),
+              std::string::npos)
+        << refused.standard_error;
+  }
+  std::remove(separate.c_str());
+  std::remove(joined.c_str());
+}
+
+// --tolerance is dopri5's local tolerance: with a fixed-step member it would change nothing, so it
+// is refused by name (whatever its value, 1e-30 too), not silently ignored.
+TEST(CartSimulate, ToleranceWithAFixedStepMemberIsRefused) {
+  for (const std::string value : {"1e-8", "1e-30"}) {
+    const CliOutcome outcome = run_cli("--scene '" + scene_path("free_coast") +
+                                       "' --integrator birkhoff_gauss4 --tolerance " + value + " --output '" +
+                                       temp_path("never.csv") + "'");
+    EXPECT_EQ(outcome.exit_status, 2) << value;
+    EXPECT_NE(outcome.standard_error.find("option --tolerance is dopri5's local tolerance [-]; birkhoff_gauss4 steps "
+                                          "at --step H"),
+              std::string::npos)
+        << outcome.standard_error;
+    EXPECT_NE(outcome.standard_error.find("--step-control reversible --position-tolerance M"), std::string::npos)
+        << outcome.standard_error;
+  }
+  const CliOutcome dopri5 = run_cli("--scene '" + scene_path("free_coast") +
+                                    "' --integrator dopri5 --tolerance 1e-8 --duration 1 --quiet --output '" +
+                                    temp_path("dopri5.csv") + "'");
+  EXPECT_EQ(dopri5.exit_status, 0) << dopri5.standard_error;
+  std::remove(temp_path("dopri5.csv").c_str());
+}
+
 // The paper's eᵗ form drifts like exp(t h²/12) (docs/birkhoffian.md §9): a run long enough for the
 // momenta to drift by more than 0.1 % is warned about on stderr, and still runs; a short one and
 // the autonomous form are not.

@@ -96,7 +96,7 @@ TEST(RandomHardCases, EveryIntegratorEndsFiniteWithAVerdictOrStopsWithANamedStep
       run.integrator.name = integrator.substr(0, integrator.find(' '));
       if (reversible) {  // "NAME reversible TOL"
         run.integrator.step_control = "reversible";
-        run.integrator.tolerance = std::stod(integrator.substr(integrator.rfind(' ') + 1));
+        run.integrator.position_tolerance = std::stod(integrator.substr(integrator.rfind(' ') + 1));
       }
       std::unique_ptr<Simulation> built;
       try {

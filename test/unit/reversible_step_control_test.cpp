@@ -155,7 +155,7 @@ Scene reversible_whirl(const std::string& member, double tolerance, double durat
   Scene scene = whirl();
   scene.integrator.name = member;
   scene.integrator.step_control = "reversible";
-  scene.integrator.tolerance = tolerance;
+  scene.integrator.position_tolerance = tolerance;
   scene.duration = duration;
   scene.integrator.step_size = output_step;
   return scene;
@@ -276,6 +276,31 @@ TEST(ReversibleStepControl, BadSettingsAreRefusedByName) {
   const std::string horizon = birkhoff_cart_test::replaced_once(text, "birkhoffian_form: autonomous",
                                                                "birkhoffian_form: autonomous\n  tolerance_horizon: 10");
   EXPECT_THROW(parse_scene(horizon, "bad.yaml"), SceneError) << "tolerance_horizon without reversible control";
+  // One meaning per key: the reversible control's position error is `position_tolerance` [m], never
+  // dopri5's `tolerance` [-] (which the shipped scenes carry); each is required or refused by name.
+  const std::string reversible = birkhoff_cart_test::replaced_once(
+      text, "birkhoffian_form: autonomous", "birkhoffian_form: autonomous\n  step_control: reversible");
+  try {
+    parse_scene(reversible, "bad.yaml");
+    FAIL() << "step_control: reversible without position_tolerance was accepted";
+  } catch (const SceneError& error) {
+    EXPECT_NE(std::string(error.what()).find("integrator.position_tolerance"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("integrator.tolerance is dopri5's"), std::string::npos) << error.what();
+  }
+  const Scene accepted = parse_scene(
+      birkhoff_cart_test::replaced_once(reversible, "step_control: reversible",
+                                        "step_control: reversible\n  position_tolerance: 1.0e-6"),
+      "good.yaml");
+  EXPECT_EQ(accepted.integrator.position_tolerance, 1e-6);
+  EXPECT_EQ(accepted.integrator.tolerance, 1e-10) << "dopri5's tolerance keeps its own meaning";
+  const std::string fixed = birkhoff_cart_test::replaced_once(text, "birkhoffian_form: autonomous",
+                                                             "birkhoffian_form: autonomous\n  position_tolerance: 1e-6");
+  try {
+    parse_scene(fixed, "bad.yaml");
+    FAIL() << "position_tolerance at fixed steps was accepted";
+  } catch (const SceneError& error) {
+    EXPECT_NE(std::string(error.what()).find("integrator.position_tolerance"), std::string::npos) << error.what();
+  }
   // A tolerance out of the member's reach is refused when the simulation is built (CLI exit 3,
   // node start-up error), not at its first step.
   try {
@@ -305,22 +330,36 @@ TEST(ReversibleStepControl, AWorkLimitStopsARunThatWouldTakeTooManySteps) {
   }
 }
 
-TEST(ReversibleStepControl, TheCliAsksForATolerance) {
-  // The shipped scenes' tolerance (1e-10) is dopri5's; as metres it would mean ~1e7 steps.
+TEST(ReversibleStepControl, TheCliAsksForAPositionTolerance) {
+  // The shipped scenes' `tolerance` (1e-10) is dopri5's local tolerance [-]: it never stands in
+  // for the position error [m], and --tolerance is refused with this control.
   const std::string csv = testing::TempDir() + "reversible_cli.csv";
   const auto without = birkhoff_cart_test::run_cart_simulate(
       "--scene " + scene_path("jackknife_whirl") + " --step-control reversible --quiet --output " + csv,
       testing::TempDir() + "reversible_cli.err");
   EXPECT_EQ(without.exit_status, 2);
-  EXPECT_NE(without.standard_error.find("needs --tolerance"), std::string::npos) << without.standard_error;
+  EXPECT_NE(without.standard_error.find("needs --position-tolerance"), std::string::npos) << without.standard_error;
+  const auto dopri5s = birkhoff_cart_test::run_cart_simulate(
+      "--scene " + scene_path("jackknife_whirl") + " --step-control reversible --tolerance 1e-5 --quiet --output " + csv,
+      testing::TempDir() + "reversible_cli.err");
+  EXPECT_EQ(dopri5s.exit_status, 2);
+  EXPECT_NE(dopri5s.standard_error.find("--tolerance is dopri5's local tolerance"), std::string::npos)
+      << dopri5s.standard_error;
+  const auto fixed = birkhoff_cart_test::run_cart_simulate(
+      "--scene " + scene_path("jackknife_whirl") + " --position-tolerance 1e-5 --quiet --output " + csv,
+      testing::TempDir() + "reversible_cli.err");
+  EXPECT_EQ(fixed.exit_status, 2);
+  EXPECT_NE(fixed.standard_error.find("--position-tolerance is the position error [m] for --step-control reversible"),
+            std::string::npos)
+      << fixed.standard_error;
   const std::string summary = testing::TempDir() + "reversible_cli.out";
   const std::string command = "'" + birkhoff_cart_test::cart_simulate_path() + "' --scene " +
                               scene_path("jackknife_whirl") +
-                              " --step-control reversible --tolerance 1e-5 --duration 1 --quiet --output " + csv + " > " +
+                              " --step-control reversible --position-tolerance 1e-5 --duration 1 --quiet --output " + csv + " > " +
                               summary;
   EXPECT_EQ(std::system(command.c_str()), 0);
   const std::string text = birkhoff_cart_test::read_file(summary);
-  EXPECT_NE(text.find("reversible step control: tolerance 1e-05 m"), std::string::npos) << text;
+  EXPECT_NE(text.find("reversible step control: position tolerance 1e-05 m"), std::string::npos) << text;
   EXPECT_NE(text.find("output step = "), std::string::npos) << text;
   std::remove(summary.c_str());
   std::remove(csv.c_str());

@@ -59,9 +59,9 @@ class ReversibleCartStepperAdapter final : public CartStepper {
   ReversibleCartStepperAdapter(const Stepper& stepper, const IntegratorSettings& settings, const CartModel& model,
                                const EffectSet& effects)
       : stepper_(stepper), system_(model, effects), effects_(&effects), settings_(settings), name_(Stepper::name()) {
-    if (!(settings.tolerance > 0.0) || !std::isfinite(settings.tolerance)) {
-      throw std::invalid_argument("step_control 'reversible' needs a finite tolerance > 0 m, got " +
-                                  std::to_string(settings.tolerance));
+    if (!(settings.position_tolerance > 0.0) || !std::isfinite(settings.position_tolerance)) {
+      throw std::invalid_argument("step_control 'reversible' needs a finite position_tolerance > 0 m, got " +
+                                  std::to_string(settings.position_tolerance));
     }
     if (!(settings.tolerance_horizon > 0.0) || !std::isfinite(settings.tolerance_horizon)) {
       throw std::invalid_argument("integrator.tolerance_horizon must be finite and > 0 s");
@@ -213,7 +213,7 @@ class ReversibleCartStepperAdapter final : public CartStepper {
             asymptotic ? p : std::clamp(std::log2(std::max(found.observed_ratio, 2.0)), 1.0, double(p));
         found.observed_order = order;
         found.pilot_error = d2 / (std::pow(2.0, order) - 1.0);
-        const double allowed = 0.5 * settings_.tolerance * window / settings_.tolerance_horizon;  // [m] at W
+        const double allowed = 0.5 * settings_.position_tolerance * window / settings_.tolerance_horizon;  // [m] at W
         found.fictive_step = epsilon / 4.0 * std::pow(allowed / std::max(found.pilot_error, noise), 1.0 / order);
         break;
       }
@@ -224,7 +224,7 @@ class ReversibleCartStepperAdapter final : public CartStepper {
     found.fictive_step = std::min({found.fictive_step, kMaxFictiveStep, found.largest_safe_step});
     if (!(found.fictive_step >= kMinFictiveStep)) {
       std::ostringstream message;
-      message << "tolerance " << settings_.tolerance << " m is out of reach for " << name_ << " (it would need eps = "
+      message << "position_tolerance " << settings_.position_tolerance << " m is out of reach for " << name_ << " (it would need eps = "
               << found.fictive_step << " rad < " << kMinFictiveStep << "): use a higher-order member or a looser tolerance";
       throw StepError(message.str());
     }
