@@ -24,6 +24,9 @@ packages=(
   python3-std-msgs python3-geometry-msgs python3-nav-msgs python3-sensor-msgs python3-diagnostic-msgs
   python3-tf2-msgs
   rosbash ros-robot-state-publisher liburdf-dev rviz xvfb
+  # the tf command-line tools beside the simulator: `rosrun tf tf_echo odom base_link`,
+  # `rosrun tf2_tools echo.py`, `rosrun tf2_tools view_frames.py` (tf_tools.test)
+  tf-tools libtf-dev tf2-tools
   libboost-dev libyaml-cpp-dev libeigen3-dev googletest libgtest-dev
   python3-matplotlib python3-numpy
   # the study runner (scripts/study): Dask distributed, its local cluster and the row tables
