@@ -1,11 +1,14 @@
 // The node's compressed rosbag record (see bag_recorder.h).
 #include "birkhoff_cart/ros/bag_recorder.h"
 
+#include <sys/stat.h>
 #include <sys/statvfs.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <stdexcept>
 
 
@@ -25,6 +28,25 @@ std::string run_bag_path(const std::string& bag_path, std::uint64_t run) {
       bag_path.size() > suffix.size() && bag_path.compare(bag_path.size() - suffix.size(), suffix.size(), suffix) == 0;
   const std::string stem = has_suffix ? bag_path.substr(0, bag_path.size() - suffix.size()) : bag_path;
   return stem + "_run" + std::to_string(run) + (has_suffix ? suffix : "");
+}
+
+std::string kept_path_for(const std::string& bag_path) {
+  struct stat info;
+  if (::stat(bag_path.c_str(), &info) != 0) {
+    throw BagRecorderError("cannot read " + bag_path + ": " + std::strerror(errno));
+  }
+  std::tm utc{};
+  const std::time_t modified = info.st_mtime;
+  ::gmtime_r(&modified, &utc);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &utc);
+  const std::string suffix = ".bag";
+  const bool has_suffix =
+      bag_path.size() > suffix.size() && bag_path.compare(bag_path.size() - suffix.size(), suffix.size(), suffix) == 0;
+  const std::string stem = (has_suffix ? bag_path.substr(0, bag_path.size() - suffix.size()) : bag_path) + "_" + stamp;
+  std::string kept = stem + suffix;
+  for (int k = 2; ::access(kept.c_str(), F_OK) == 0; ++k) kept = stem + "-" + std::to_string(k) + suffix;
+  return kept;
 }
 
 std::string disk_space_shortage(const std::string& directory, std::uint64_t free_bytes,
@@ -55,6 +77,14 @@ BagRecorder::BagRecorder(const std::string& path, Compression compression, std::
     }
     const std::string shortage = disk_space_shortage(directory, free_bytes, min_free_disk_space);
     if (!shortage.empty()) throw BagRecorderError("cannot record to " + path + ": " + shortage);
+  }
+  if (::access(path.c_str(), F_OK) == 0) {  // an earlier bag: kept under its time, never overwritten
+    const std::string kept = kept_path_for(path);
+    if (std::rename(path.c_str(), kept.c_str()) != 0) {
+      throw BagRecorderError("cannot record to " + path + ": a file is there and cannot be moved to " + kept + ": " +
+                             std::strerror(errno));
+    }
+    earlier_bag_kept_as_ = kept;
   }
   BagFileWriter::Compression file_compression = BagFileWriter::Compression::kLz4;
   switch (compression) {

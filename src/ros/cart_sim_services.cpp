@@ -89,6 +89,10 @@ void CartSimNode::open_record(const std::string& path) {
   recorder_ = std::make_unique<BagRecorder>(run_bag_path(path, run_index_),
                                             BagRecorder::parse_compression(parameters_.bag_compression),
                                             parameters_.min_free_disk_space);
+  if (!recorder_->earlier_bag_kept_as().empty()) {
+    ROS_WARN("cart_sim: %s already held a bag: kept it as %s (a record never overwrites one)",
+             recorder_->path().c_str(), recorder_->earlier_bag_kept_as().c_str());
+  }
 }
 
 bool CartSimNode::on_pause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response) {

@@ -1,6 +1,7 @@
 // BagRecorder's ring and writer thread: more messages than the ring holds, written as fast as the
 // loop can (the full-ring wait and the batched wake-up of the writer), all reach the bag in order;
-// fewer than one wake-up batch are written at close(). No master needed; files in a scratch
+// fewer than one wake-up batch are written at close(); a bag already at the path is kept under
+// its modification time, never overwritten. No master needed; files in a scratch
 // directory removed at the end.
 #include <gtest/gtest.h>
 
@@ -58,6 +59,52 @@ TEST(BagRecorder, MoreMessagesThanTheRingHoldsAllReachTheBagInOrder) {
 
 TEST(BagRecorder, FewerMessagesThanOneWakeUpBatchAreWrittenAtClose) {
   record_and_check(BagRecorder::kWakeBatch / 2);
+}
+
+TEST(BagRecorder, AnEarlierBagAtThePathIsKeptUnderItsTime) {
+  char pattern[] = "/tmp/bag_recorder_test.XXXXXX";
+  const char* directory = ::mkdtemp(pattern);
+  ASSERT_NE(directory, nullptr);
+  const std::string path = std::string(directory) + "/run.bag";
+  std::FILE* earlier = std::fopen(path.c_str(), "w");
+  ASSERT_NE(earlier, nullptr);
+  std::fputs("the earlier run", earlier);
+  std::fclose(earlier);
+  const std::string kept = kept_path_for(path);
+  EXPECT_EQ(kept.rfind(std::string(directory) + "/run_2", 0), 0u) << kept;  // run_<YYYYMMDD-HHMMSS>.bag
+  EXPECT_EQ(kept.size(), path.size() + 16) << kept;
+  {
+    BagRecorder recorder(path, BagRecorder::Compression::kNone);
+    EXPECT_EQ(recorder.earlier_bag_kept_as(), kept);
+    std_msgs::Float64 command;
+    command.data = 1.0;
+    recorder.write("/steering_torque", ros::Time(1.0), command);
+    recorder.close();
+  }
+  std::FILE* moved = std::fopen(kept.c_str(), "r");
+  ASSERT_NE(moved, nullptr) << "the earlier bag is gone";
+  char text[32] = {};
+  EXPECT_NE(std::fgets(text, sizeof text, moved), nullptr);
+  std::fclose(moved);
+  EXPECT_STREQ(text, "the earlier run");
+  {
+    rosbag::Bag bag(path, rosbag::bagmode::Read);
+    EXPECT_EQ(rosbag::View(bag).size(), 1u);
+  }
+  // A second earlier bag with the same time stamp gets "-2".
+  std::FILE* again = std::fopen(kept.c_str(), "r");
+  ASSERT_NE(again, nullptr);
+  std::fclose(again);
+  std::string second;
+  {
+    BagRecorder recorder(path, BagRecorder::Compression::kNone);
+    second = recorder.earlier_bag_kept_as();
+    recorder.close();
+  }
+  EXPECT_FALSE(second.empty());
+  EXPECT_NE(second, kept);
+  for (const std::string& file : {path, kept, second}) std::remove(file.c_str());
+  ::rmdir(directory);
 }
 
 }  // namespace

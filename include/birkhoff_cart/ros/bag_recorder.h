@@ -59,6 +59,11 @@ std::string disk_space_shortage(const std::string& directory, std::uint64_t free
 /// (statvfs: f_bavail × f_frsize). Throws BagRecorderError naming the directory when statvfs fails.
 std::uint64_t free_disk_space(const std::string& directory);
 
+/// The name an earlier bag at `bag_path` is kept under: "<stem>_<its modification time, UTC,
+/// YYYYMMDD-HHMMSS>.bag", with "-2", "-3", ... after the time when that name is taken too.
+/// Throws BagRecorderError when the file cannot be read (stat).
+std::string kept_path_for(const std::string& bag_path);
+
 class BagRecorder {
  public:
   enum class Compression { kNone, kLz4, kBz2 };
@@ -70,7 +75,9 @@ class BagRecorder {
   /// Messages queued before the waiting writer thread is woken (close() wakes it for the rest).
   static constexpr std::size_t kWakeBatch = 256;
 
-  /// Opens "<path>.active" for writing and starts the writer thread. Throws BagRecorderError when
+  /// Opens "<path>.active" for writing and starts the writer thread. A file already at `path` (an
+  /// earlier run's bag) is never overwritten: it is first renamed to kept_path_for() of it, and
+  /// earlier_bag_kept_as() says where. Throws BagRecorderError when
   /// it cannot (missing or unwritable directory, empty path, ...) or, with `min_free_disk_space` >
   /// 0 [bytes], when the bag's directory has less free space than that (checked before anything
   /// is created).
@@ -125,6 +132,8 @@ class BagRecorder {
   /// Where the bag is now: path() after a successful close(), active_path() otherwise (still
   /// open, or left unfinished by a failed close).
   std::string current_path() const { return finished_ ? path_ : active_path(); }
+  /// Where the file found at path() when recording began went ("" when there was none).
+  const std::string& earlier_bag_kept_as() const { return earlier_bag_kept_as_; }
   /// Messages written to the file per topic (complete after close()).
   std::map<std::string, std::uint64_t> message_counts() const;
 
@@ -147,6 +156,7 @@ class BagRecorder {
   std::string free_space_note() const;
 
   std::string path_;
+  std::string earlier_bag_kept_as_;
   std::unique_ptr<BagFileWriter> bag_;
   bool open_ = false;      ///< accepting writes (mutex_)
   bool finished_ = false;  ///< closed and renamed to path_
