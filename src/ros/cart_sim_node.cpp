@@ -12,6 +12,7 @@
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/ros/accuracy_reporting.h"
 #include "birkhoff_cart/ros/instant_schedule.h"
+#include "birkhoff_cart/ros/parameter_reading.h"
 
 namespace birkhoff_cart {
 namespace {
@@ -29,6 +30,9 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
     parameters_ = load_parameters(private_node_);
   } catch (const std::exception& error) {
     throw NodeStartupError(std::string("bad parameter: ") + error.what());
+  }
+  for (const std::string& report : unknown_private_parameters(private_node_, cart_sim_parameter_names())) {
+    ROS_WARN("cart_sim: %s", report.c_str());
   }
   Scene scene;
   try {

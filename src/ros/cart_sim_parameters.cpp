@@ -57,6 +57,18 @@ std::string format_seconds(double value) {
   return text.str();
 }
 
+const std::vector<std::string>& cart_sim_parameter_names() {
+  static const std::vector<std::string> names = {
+      "scene", "integrator", "step_size", "publish_rate", "fast", "real_time_factor", "duration", "command_timeout",
+      "max_steering_torque", "max_drive_torque", "lockstep", "lockstep_topics", "lockstep_timeout", "bag_path",
+      "record_wall_time", "bag_compression", "min_free_disk_space", "summary_path", "frame_prefix", "odom_frame",
+      "base_frame", "pose_covariance_diagonal", "twist_covariance_diagonal", "publish_tf", "publish_clock",
+      "follow_clock", "start_paused", "diagnostic_period", "energy_residual_warn", "energy_residual_error",
+      "p2_residual_warn", "p2_residual_error", "constraint_residual_warn", "constraint_residual_error", "end_launch",
+      "accuracy/"};
+  return names;
+}
+
 CartSimParameters load_parameters(const ros::NodeHandle& private_node) {
   CartSimParameters parameters;
   const ros::NodeHandle& p = private_node;

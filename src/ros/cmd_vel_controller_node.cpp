@@ -7,6 +7,7 @@
 
 #include <std_msgs/Float64.h>
 
+#include "birkhoff_cart/core/closest_name.h"
 #include "birkhoff_cart/ros/parameter_reading.h"
 
 namespace birkhoff_cart {
@@ -78,6 +79,17 @@ CmdVelControllerNode::CmdVelControllerNode(ros::NodeHandle node, ros::NodeHandle
                                          ros::TransportHints().tcpNoDelay());
   joint_state_subscriber_ = node_.subscribe("joint_states", 10, &CmdVelControllerNode::on_joint_states, this,
                                             ros::TransportHints().tcpNoDelay());
+  static const std::vector<std::string> kKnown = {
+      "wheel_separation_h", "cmd_vel_timeout", "zero_speed", "steering_joint", "linear/x/max_velocity",
+      "linear/x/min_velocity", "linear/x/has_velocity_limits", "linear/x/max_acceleration", "linear/x/min_acceleration",
+      "linear/x/has_acceleration_limits", "angular/z/max_velocity", "angular/z/has_velocity_limits",
+      "angular/z/max_acceleration", "angular/z/has_acceleration_limits", "steering/max_angle", "steering/max_rate",
+      "steering/max_torque", "steering/p", "steering/d", "drive/max_torque", "drive/ff", "drive/p", "drive/i",
+      "drive/i_clamp"};
+  for (const std::string& report : unknown_private_parameters(private_node_, kKnown)) {
+    ROS_WARN("cmd_vel_controller: %s", report.c_str());
+  }
+  joint_check_ = node_.createWallTimer(ros::WallDuration(0.1), &CmdVelControllerNode::check_joint_names, this);
   const CmdVelControllerSettings& s = controller_.settings();
   ROS_INFO("cmd_vel_controller: %s -> %s, %s; l = %g m, v in [%g, %g] m/s, |r| <= %g rad/s, |chi| <= %g rad, "
            "|tau| <= %g N m, |T| <= %g N m, cmd_vel_timeout %g s",
@@ -108,6 +120,24 @@ void CmdVelControllerNode::on_cmd_vel(const geometry_msgs::Twist::ConstPtr& mess
   timeout_reported_ = false;
 }
 
+void CmdVelControllerNode::check_joint_names(const ros::WallTimerEvent&) {
+  if (steering_joint_seen_) {
+    joint_check_.stop();
+    return;
+  }
+  if (!first_without_joint_ || (ros::WallTime::now() - *first_without_joint_).toSec() < kJointGrace) return;
+  std::string names;
+  for (const std::string& name : names_without_joint_) names += (names.empty() ? "" : ", ") + name;
+  const std::string guess = closest_name(steering_joint_, names_without_joint_);
+  refusal_ = "joint '" + steering_joint_ + "' (" + private_node_.resolveName("steering_joint") +
+             ") is not in " + joint_state_subscriber_.getTopic() + ", which names " + (names.empty() ? "no joint" : names) +
+             (guess.empty() ? "" : " (did you mean '" + guess + "'?)") +
+             ": without the steering angle the controller cannot steer, so it does not run";
+  ROS_FATAL("cmd_vel_controller: %s", refusal_.c_str());
+  joint_check_.stop();
+  ros::shutdown();
+}
+
 void CmdVelControllerNode::on_odometry(const nav_msgs::Odometry::ConstPtr& message) {
   odometry_stamp_ = message->header.stamp;
   base_speed_ = message->twist.twist.linear.x;
@@ -116,7 +146,14 @@ void CmdVelControllerNode::on_odometry(const nav_msgs::Odometry::ConstPtr& messa
 
 void CmdVelControllerNode::on_joint_states(const sensor_msgs::JointState::ConstPtr& message) {
   const auto joint = std::find(message->name.begin(), message->name.end(), steering_joint_);
-  if (joint == message->name.end()) return;  // another publisher's joints
+  if (joint == message->name.end()) {  // another publisher's joints, or a wrong ~steering_joint
+    if (!first_without_joint_) {
+      first_without_joint_ = ros::WallTime::now();
+      names_without_joint_ = message->name;
+    }
+    return;
+  }
+  steering_joint_seen_ = true;
   const std::size_t index = static_cast<std::size_t>(joint - message->name.begin());
   if (index >= message->position.size() || index >= message->velocity.size()) {
     ROS_WARN_THROTTLE(5.0, "cmd_vel_controller: joint_states without position and velocity of %s",

@@ -3,6 +3,10 @@
 
 #include <stdexcept>
 
+#include <ros/param.h>
+
+#include "birkhoff_cart/core/closest_name.h"
+
 #include <XmlRpcValue.h>
 
 namespace birkhoff_cart {
@@ -22,6 +26,29 @@ double read_double_parameter(const ros::NodeHandle& node, const std::string& nam
     }
   }
   throw std::invalid_argument("parameter " + node.resolveName(name) + " must be a number");
+}
+
+std::vector<std::string> unknown_private_parameters(const ros::NodeHandle& private_node,
+                                                    const std::vector<std::string>& known) {
+  std::vector<std::string> all;
+  std::vector<std::string> reports;
+  if (!ros::param::getParamNames(all)) return reports;  // no master answer: nothing to say
+  const std::string prefix = private_node.getNamespace() + "/";
+  for (const std::string& name : all) {
+    if (name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string relative = name.substr(prefix.size());
+    bool read = false;
+    for (const std::string& entry : known) {
+      read = read || relative == entry ||
+             (!entry.empty() && entry.back() == '/' && relative.compare(0, entry.size(), entry) == 0);
+    }
+    if (read) continue;
+    const std::string guess = closest_name(relative, known);
+    reports.push_back("parameter " + name + " is not one of this node's and is ignored" +
+                      (guess.empty() ? std::string(" (docs/ros_interface.md lists them)")
+                                     : " (did you mean " + prefix + guess + "?)"));
+  }
+  return reports;
 }
 
 }  // namespace birkhoff_cart

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """rostest node_log: with /use_sim_time false cart_sim says so (ROS_WARN naming the parameter) and
-still runs; with ~follow_clock it refuses to start (exit 2, ROS_FATAL); its log is ASCII; a fast
+still runs; a misspelled private parameter is named with the closest one it reads; with ~follow_clock it refuses to start (exit 2, ROS_FATAL); its log is ASCII; a fast
 run longer than a second of wall time logs progress lines (scene time, percent, real-time factor)."""
 import re
 import os
@@ -44,6 +44,12 @@ class NodeLog(unittest.TestCase):
         self.assertIn("must be > 0 N m", result.stdout)
         result.stdout.encode("ascii")  # raises on "N·m" and the like
 
+
+    def test_names_the_closest_parameter_for_a_typo(self):
+        result = cart_sim("typo_sim", "_duration:=0.1", "_publsh_rate:=50")
+        self.assertEqual(result.returncode, 0, result.stdout)
+        self.assertIn("parameter /typo_sim/publsh_rate is not one of this node's and is ignored "
+                      "(did you mean /typo_sim/publish_rate?)", result.stdout)
 
     def test_reports_progress_in_a_long_fast_run(self):
         # 3 s of scene time paced at twice real time: ~1.5 s of wall time, so at least one line.

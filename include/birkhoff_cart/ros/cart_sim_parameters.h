@@ -49,6 +49,10 @@ struct CartSimParameters {
   double constraint_residual_error = 1e-6;   ///< ~constraint_residual_error: [m/s]
 };
 
+/// Every private parameter cart_sim reads, relative to its namespace ("accuracy/" covers the
+/// accuracy guard's limits): a parameter on the master outside this list is reported as a typo.
+const std::vector<std::string>& cart_sim_parameter_names();
+
 /// Reads and validates every private parameter. Throws std::invalid_argument naming the first bad one.
 CartSimParameters load_parameters(const ros::NodeHandle& private_node);
 

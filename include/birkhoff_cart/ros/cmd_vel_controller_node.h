@@ -12,7 +12,9 @@
 // /use_sim_time is false.
 #pragma once
 
+#include <optional>
 #include <string>
+#include <vector>
 
 #include <geometry_msgs/Twist.h>
 #include <nav_msgs/Odometry.h>
@@ -33,7 +35,15 @@ class CmdVelControllerNode {
   /// Throws std::invalid_argument for a bad parameter.
   CmdVelControllerNode(ros::NodeHandle node, ros::NodeHandle private_node);
 
+  /// How long joint_states may come without ~steering_joint before the controller refuses to run
+  /// [s of wall time]: a wrong joint name is a configuration error, as at a peer controller's load.
+  static constexpr double kJointGrace = 1.0;
+  /// Why the controller stopped itself ("" while it runs): ~steering_joint is not in joint_states.
+  const std::string& refusal() const { return refusal_; }
+
  private:
+  /// Refuses (ROS_FATAL, ros::shutdown) when joint_states has come for kJointGrace without the joint.
+  void check_joint_names(const ros::WallTimerEvent&);
   void on_cmd_vel(const geometry_msgs::Twist::ConstPtr& message);
   void on_odometry(const nav_msgs::Odometry::ConstPtr& message);
   void on_joint_states(const sensor_msgs::JointState::ConstPtr& message);
@@ -59,6 +69,11 @@ class CmdVelControllerNode {
   ros::Time last_update_stamp_;   ///< the instant the law last ran on
   ros::Time latest_stamp_;        ///< the latest simulator instant seen (cmd_vel arrival time)
   bool timeout_reported_ = false;
+  bool steering_joint_seen_ = false;           ///< some joint_states held ~steering_joint
+  std::optional<ros::WallTime> first_without_joint_;  ///< the first joint_states without it
+  std::vector<std::string> names_without_joint_;      ///< the joint names that message held
+  ros::WallTimer joint_check_;
+  std::string refusal_;
 };
 
 }  // namespace birkhoff_cart

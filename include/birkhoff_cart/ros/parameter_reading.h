@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <ros/node_handle.h>
 
@@ -12,5 +13,12 @@ namespace birkhoff_cart {
 /// integer (publish_rate: 100) or a string that is a whole number (roslaunch <param value="1e-3"/>
 /// without a type). Throws std::invalid_argument naming the resolved parameter otherwise.
 double read_double_parameter(const ros::NodeHandle& node, const std::string& name, double fallback);
+
+/// One line for each parameter on the master under `private_node`'s namespace that the node does
+/// not read (a typo is otherwise ignored without a word): its name, and the closest of `known`
+/// (names relative to the namespace, "linear/x/max_velocity") when one is within a typo's reach.
+/// A known name ending in '/' covers everything below it.
+std::vector<std::string> unknown_private_parameters(const ros::NodeHandle& private_node,
+                                                    const std::vector<std::string>& known);
 
 }  // namespace birkhoff_cart
