@@ -108,8 +108,12 @@ void CartSimNode::wait_for_commands(double time) {
 void CartSimNode::wait_for_clock(double time) {
   // ros::Time::now() is the /clock of the node that drives it (roscpp hears /clock on its own
   // thread). 1 µs allows for the nanosecond rounding of ROS time.
+  // A ~reset served while waiting ends the wait: `time` belongs to the run before it, and the
+  // leader's /clock (reset too) would reach it only after as long again.
   constexpr double kStampRounding = 1e-6;  // [s]
-  while (ros::Time::now().toSec() < time - kStampRounding && !stop_requested() && !paused_) {
+  const std::uint64_t resets_before = resets_;
+  while (ros::Time::now().toSec() < time - kStampRounding && !stop_requested() && !paused_ &&
+         resets_ == resets_before) {
     callback_queue_.wait_until(after(0.01));
     process_callbacks();
   }

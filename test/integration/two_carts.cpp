@@ -3,7 +3,8 @@
 // odom, joint_states and the tf tree (cartN/odom → cartN/base_link from cart_sim, the links from its
 // robot_state_publisher) carry its own prefix, and its odometry agrees with a core Simulation of its
 // own scene at every stamp; the two trees share no frame; /clock has one publisher and never goes
-// back.
+// back. Reset both (the clock source first): the follower's new run starts on the leader's new
+// clock at once.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,6 +15,7 @@
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
 #include <sensor_msgs/JointState.h>
+#include <std_srvs/Empty.h>
 #include <tf2/utils.h>
 #include <tf2_ros/transform_listener.h>
 
@@ -30,6 +32,7 @@ constexpr double kStampTolerance = 1e-9;     // [s]
 constexpr double kWaitTimeout = 60.0;        // [s of wall time], only against hangs
 constexpr double kDuration = 2.0;            // the span checked, from both carts' start [s]
 constexpr double kPublishRate = 50.0;        // both carts' ~publish_rate [Hz]
+constexpr double kResetAfter = 8.0;          // scene time cart2 reaches before both carts are reset [s]
 
 /// What one cart publishes, collected by topic.
 struct CartRecord {
@@ -137,6 +140,33 @@ TEST(TwoCarts, EachCartHasItsOwnTreeAndOdometryUnderOneClock) {
   // The carts really moved apart from rest.
   EXPECT_GT(std::abs(cart2.odometry[expected - 1].pose.pose.position.x - cart2.odometry.front().pose.pose.position.x),
             1.0);
+
+  // Resetting both carts, the clock source first: the follower starts its new run at once, on the
+  // leader's new clock, instead of waiting (silent) until /clock has passed its pre-reset time.
+  ASSERT_TRUE(birkhoff_cart_test::wait_for(
+      [&] { return cart2.odometry.back().header.stamp.toSec() >= kResetAfter; }, kWaitTimeout));
+  const double before_reset = cart2.odometry.back().header.stamp.toSec();  // [s]
+  const std::size_t clocks_before_reset = clocks.size();
+  std_srvs::Empty reset;
+  ASSERT_TRUE(ros::service::call("/cart1/cart_sim/reset", reset));
+  ASSERT_TRUE(ros::service::call("/cart2/cart_sim/reset", reset));
+  // /clock messages of the leader's new run that came before the follower's first new odom: a
+  // handful when the follower starts at once; about before_reset × 50 Hz when it waits for /clock
+  // to come back to its pre-reset time.
+  std::size_t new_clocks_first = 0;
+  ASSERT_TRUE(birkhoff_cart_test::wait_for(
+      [&] {
+        if (cart2.odometry.back().header.stamp.toSec() >= 0.5 * before_reset) return false;
+        for (std::size_t i = clocks_before_reset; i < clocks.size(); ++i) {
+          new_clocks_first += clocks[i].toSec() < 0.5 * before_reset ? 1 : 0;
+        }
+        return true;
+      },
+      kWaitTimeout))
+      << "cart2 published nothing of its new run: " << cart2.odometry.size() << " odom, the last at "
+      << cart2.odometry.back().header.stamp.toSec() << " s; /clock at " << clocks.back().toSec() << " s";
+  EXPECT_LT(new_clocks_first, 50u) << "cart2 resumed only after " << new_clocks_first
+                                   << " /clock messages of the new run (reset at " << before_reset << " s)";
 }
 
 }  // namespace
