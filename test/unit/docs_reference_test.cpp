@@ -1,7 +1,8 @@
 // The user documentation against the code it describes: the CLI page shows exactly what
 // `cart_simulate --help` prints, every registered integrator is documented, every relative link
-// of README.md and docs/*.md reaches a file, no page or source tells the development history, and
-// the README stays a short front door.
+// of README.md and docs/*.md reaches a file, no page or source tells the development history, the
+// README stays a short front door, and the counts the pages state are the counts of the files and
+// tests they describe.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -9,6 +10,8 @@
 #include <regex>
 #include <string>
 #include <vector>
+
+#include <yaml-cpp/yaml.h>
 
 #include "birkhoff_cart/core/integrators/cart_stepper.h"
 #include "test_scenes.h"
@@ -112,6 +115,57 @@ TEST(DocsReference, NoSourceOrPageTellsTheDevelopmentHistory) {
   const std::string readme = read_file(kSourceDirectory + "/README.md");
   EXPECT_FALSE(std::regex_search(readme, history)) << "README.md tells the development history";
   EXPECT_GT(files, 100);
+}
+
+/// "eleven" for 11 (the README spells small counts).
+std::string number_word(std::size_t n) {
+  static const char* const kWords[] = {"zero", "one",   "two",    "three",  "four",    "five",    "six",
+                                       "seven", "eight", "nine",  "ten",    "eleven",  "twelve",  "thirteen",
+                                       "fourteen", "fifteen", "sixteen", "seventeen", "eighteen", "nineteen", "twenty"};
+  return n < sizeof kWords / sizeof kWords[0] ? kWords[n] : std::to_string(n);
+}
+
+/// Test cases of a gtest binary beside this one (--gtest_list_tests).
+std::size_t gtest_cases(const std::string& binary) {
+  const std::string listing =
+      standard_output_of("'" + birkhoff_cart_test::directory_of_this_binary() + "/" + binary + "' --gtest_list_tests");
+  std::size_t cases = 0;
+  for (std::size_t at = 0; (at = listing.find("\n  ", at)) != std::string::npos; ++at) ++cases;
+  return cases;
+}
+
+std::size_t study_runs(const std::string& study_file, const char* family_key) {
+  const YAML::Node study = YAML::LoadFile(kSourceDirectory + "/" + study_file);
+  const YAML::Node experiment = study["experiments"][0];
+  const std::size_t count = experiment[family_key]["count"].as<std::size_t>();
+  return experiment["integrators"] ? count * experiment["integrators"].size() : count;
+}
+
+TEST(DocsReference, TheCountsThePagesStateAreTheCountsOfTheFiles) {
+  const std::string readme = read_file(kSourceDirectory + "/README.md");
+  std::size_t scenes = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(kSourceDirectory + "/config/scenes")) {
+    scenes += entry.path().extension() == ".yaml" ? 1 : 0;
+  }
+  EXPECT_NE(readme.find("ships " + number_word(scenes) + " scenes"), std::string::npos)
+      << "config/scenes/ holds " << scenes << " scenes";
+  const std::size_t cart_keys = YAML::LoadFile(kSourceDirectory + "/config/scenes/default.yaml")["cart"].size();
+  EXPECT_NE(readme.find("the cart's " + std::to_string(cart_keys) + " physical parameters"), std::string::npos)
+      << "a scene's cart map has " << cart_keys << " keys";
+  EXPECT_NE(read_file(kSourceDirectory + "/docs/scenes.md").find("the " + std::to_string(cart_keys) + " physical parameters"),
+            std::string::npos);
+  EXPECT_NE(readme.find(std::to_string(study_runs("bench/studies/random_carts.yaml", "random_scenes")) +
+                        " runs of random carts"),
+            std::string::npos)
+      << "bench/studies/random_carts.yaml changed its size";
+  EXPECT_NE(readme.find(std::to_string(study_runs("checks/studies/cli_sweep.yaml", "random_runs")) +
+                        " random CLI inputs"),
+            std::string::npos)
+      << "checks/studies/cli_sweep.yaml changed its size";
+  const std::string hard_cases = read_file(kSourceDirectory + "/docs/hard_cases.md");
+  EXPECT_NE(hard_cases.find("hard_cases_test.cpp` (§1–§6, " + std::to_string(gtest_cases("hard_cases_test")) + " cases"),
+            std::string::npos)
+      << "hard_cases_test has " << gtest_cases("hard_cases_test") << " cases";
 }
 
 TEST(DocsReference, TheReadmeIsAFrontDoorOfAtMost25KB) {
