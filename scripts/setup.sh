@@ -27,6 +27,8 @@ packages=(
   # the tf command-line tools beside the simulator: `rosrun tf tf_echo odom base_link`,
   # `rosrun tf2_tools echo.py`, `rosrun tf2_tools view_frames.py` (tf_tools.test)
   tf-tools libtf-dev tf2-tools
+  # cmd_vel_controller's run-time settings (cfg/CmdVelController.cfg; `rosrun dynamic_reconfigure dynparam`)
+  libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   libboost-dev libyaml-cpp-dev libeigen3-dev googletest libgtest-dev
   python3-matplotlib python3-numpy
   # the study runner (scripts/study): Dask distributed, its local cluster and the row tables

@@ -63,6 +63,14 @@ CmdVelController::CmdVelController(const CmdVelControllerSettings& settings) : s
   validate(settings_);
 }
 
+void CmdVelController::set_settings(const CmdVelControllerSettings& settings) {
+  validate(settings);
+  if (settings.wheel_separation_h != settings_.wheel_separation_h) {
+    throw std::invalid_argument("wheel_separation_h cannot change while running (it is the cart's geometry)");
+  }
+  settings_ = settings;
+}
+
 bool CmdVelController::set_command(double speed, double yaw_rate, double time) {
   if (!std::isfinite(speed) || !std::isfinite(yaw_rate) || !std::isfinite(time)) return false;
   commanded_speed_ = speed;

@@ -26,6 +26,29 @@ bool read_switch(const ros::NodeHandle& node, const std::string& name) {
 
 constexpr double kNoLimit = 1e9;  // stands for "unlimited" in a finite-limit slot
 
+/// The settings as dynamic_reconfigure's config (cfg/CmdVelController.cfg names).
+CmdVelControllerConfig to_config(const CmdVelControllerSettings& s) {
+  CmdVelControllerConfig config;
+  config.cmd_vel_timeout = s.cmd_vel_timeout;
+  config.linear_x_max_velocity = s.max_velocity;
+  config.linear_x_min_velocity = s.min_velocity;
+  config.linear_x_max_acceleration = s.max_acceleration;
+  config.linear_x_min_acceleration = s.min_acceleration;
+  config.angular_z_max_velocity = s.max_yaw_rate;
+  config.angular_z_max_acceleration = s.max_yaw_acceleration;
+  config.steering_max_angle = s.max_steering_angle;
+  config.steering_max_rate = s.max_steering_rate;
+  config.steering_max_torque = s.max_steering_torque;
+  config.steering_p = s.steering_p;
+  config.steering_d = s.steering_d;
+  config.drive_max_torque = s.max_drive_torque;
+  config.drive_ff = s.drive_ff;
+  config.drive_p = s.drive_p;
+  config.drive_i = s.drive_i;
+  config.drive_i_clamp = s.drive_i_clamp;
+  return config;
+}
+
 }  // namespace
 
 CmdVelControllerSettings load_cmd_vel_controller_settings(const ros::NodeHandle& p) {
@@ -85,10 +108,20 @@ CmdVelControllerNode::CmdVelControllerNode(ros::NodeHandle node, ros::NodeHandle
       "linear/x/has_acceleration_limits", "angular/z/max_velocity", "angular/z/has_velocity_limits",
       "angular/z/max_acceleration", "angular/z/has_acceleration_limits", "steering/max_angle", "steering/max_rate",
       "steering/max_torque", "steering/p", "steering/d", "drive/max_torque", "drive/ff", "drive/p", "drive/i",
-      "drive/i_clamp"};
+      "drive/i_clamp",
+      // dynamic_reconfigure's own copies (cfg/CmdVelController.cfg), left on the master by an earlier run
+      "cmd_vel_timeout", "linear_x_max_velocity", "linear_x_min_velocity", "linear_x_max_acceleration",
+      "linear_x_min_acceleration", "angular_z_max_velocity", "angular_z_max_acceleration", "steering_max_angle",
+      "steering_max_rate", "steering_max_torque", "steering_p", "steering_d", "drive_max_torque", "drive_ff", "drive_p",
+      "drive_i", "drive_i_clamp"};
   for (const std::string& report : unknown_private_parameters(private_node_, kKnown)) {
     ROS_WARN("cmd_vel_controller: %s", report.c_str());
   }
+  reconfigure_server_ =
+      std::make_unique<dynamic_reconfigure::Server<CmdVelControllerConfig>>(reconfigure_mutex_, private_node_);
+  reconfigure_server_->updateConfig(to_config(controller_.settings()));  // the start-up values, not the cfg's
+  reconfigure_server_->setCallback(
+      [this](CmdVelControllerConfig& config, std::uint32_t level) { on_reconfigure(config, level); });
   joint_check_ = node_.createWallTimer(ros::WallDuration(0.1), &CmdVelControllerNode::check_joint_names, this);
   const CmdVelControllerSettings& s = controller_.settings();
   ROS_INFO("cmd_vel_controller: %s -> %s, %s; l = %g m, v in [%g, %g] m/s, |r| <= %g rad/s, |chi| <= %g rad, "
@@ -118,6 +151,36 @@ void CmdVelControllerNode::on_cmd_vel(const geometry_msgs::Twist::ConstPtr& mess
                       "other components of cmd_vel");
   }
   timeout_reported_ = false;
+}
+
+void CmdVelControllerNode::on_reconfigure(CmdVelControllerConfig& config, std::uint32_t /*level*/) {
+  CmdVelControllerSettings settings = controller_.settings();
+  settings.cmd_vel_timeout = config.cmd_vel_timeout;
+  settings.max_velocity = config.linear_x_max_velocity;
+  settings.min_velocity = config.linear_x_min_velocity;
+  settings.max_acceleration = config.linear_x_max_acceleration;
+  settings.min_acceleration = config.linear_x_min_acceleration;
+  settings.max_yaw_rate = config.angular_z_max_velocity;
+  settings.max_yaw_acceleration = config.angular_z_max_acceleration;
+  settings.max_steering_angle = config.steering_max_angle;
+  settings.max_steering_rate = config.steering_max_rate;
+  settings.max_steering_torque = config.steering_max_torque;
+  settings.steering_p = config.steering_p;
+  settings.steering_d = config.steering_d;
+  settings.max_drive_torque = config.drive_max_torque;
+  settings.drive_ff = config.drive_ff;
+  settings.drive_p = config.drive_p;
+  settings.drive_i = config.drive_i;
+  settings.drive_i_clamp = config.drive_i_clamp;
+  try {
+    controller_.set_settings(settings);
+    ROS_INFO("cmd_vel_controller: reconfigured: v in [%g, %g] m/s, |r| <= %g rad/s, steering p %g d %g, drive p %g i %g, "
+             "cmd_vel_timeout %g s", settings.min_velocity, settings.max_velocity, settings.max_yaw_rate,
+             settings.steering_p, settings.steering_d, settings.drive_p, settings.drive_i, settings.cmd_vel_timeout);
+  } catch (const std::invalid_argument& error) {
+    ROS_ERROR("cmd_vel_controller: reconfiguration refused (the running settings stay): %s", error.what());
+    config = to_config(controller_.settings());  // dynamic_reconfigure reports the settings in force
+  }
 }
 
 void CmdVelControllerNode::check_joint_names(const ros::WallTimerEvent&) {

@@ -113,6 +113,21 @@ class CmdVelConformance(unittest.TestCase):
         self.assertIn("parameter /typo/typo_controller/cmd_vel_timout is not one of this node's and is ignored "
                       "(did you mean /typo/typo_controller/cmd_vel_timeout?)", "".join(output))
 
+    def test_7_takes_new_limits_while_running_and_refuses_a_bad_set(self):
+        from dynamic_reconfigure.client import Client
+        client = Client("/cmd_vel_controller", timeout=20)
+        in_force = client.update_configuration({"linear_x_max_velocity": 2.0})
+        self.assertEqual(in_force["linear_x_max_velocity"], 2.0)
+        speeds = [speed for speed, _ in self.drive(10.0, 0.0, 4.0)]
+        self.assertLessEqual(max(speeds), 2.0 + 0.05)
+        self.assertGreater(speeds[-1], 1.8)
+        # Braking must stay a deceleration: 0 is refused, the running settings stay.
+        in_force = client.update_configuration({"linear_x_min_acceleration": 0.0})
+        self.assertEqual(in_force["linear_x_min_acceleration"], -3.0)
+        self.assertEqual(in_force["linear_x_max_velocity"], 2.0)
+        client.update_configuration({"linear_x_max_velocity": 3.0})
+        self.settle()
+
 
 if __name__ == "__main__":
     rostest.rosrun(PACKAGE, "cmd_vel_conformance", CmdVelConformance)

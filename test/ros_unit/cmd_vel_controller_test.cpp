@@ -171,6 +171,42 @@ TEST(CmdVelController, RefusesBadSettingsByName) {
   refused([](CmdVelControllerSettings& s) { s.max_drive_torque = 0.0; }, "drive/max_torque");
 }
 
+// dynamic_reconfigure's path: new limits and gains take effect at the next update, the command
+// carries on; a bad set or a new geometry is refused by name and the running settings stay.
+TEST(CmdVelController, NewSettingsWhileRunningOrARefusalThatKeepsTheOld) {
+  CmdVelController controller{CmdVelControllerSettings{}};
+  ASSERT_TRUE(controller.set_command(10.0, 0.0, 0.0));
+  CmdVelControllerSettings slower = controller.settings();
+  slower.max_velocity = 2.0;
+  slower.steering_p = 200.0;
+  controller.set_settings(slower);
+  EXPECT_EQ(controller.settings().max_velocity, 2.0);
+  EXPECT_EQ(controller.settings().steering_p, 200.0);
+  CartFeedback feedback;
+  feedback.time = 0.01;
+  controller.update(feedback);
+  for (int k = 2; k <= 400; ++k) {  // 4 s of a 10 m/s command, renewed before its timeout
+    feedback.time = 0.01 * k;
+    ASSERT_TRUE(controller.set_command(10.0, 0.0, feedback.time));
+    controller.update(feedback);
+  }
+  EXPECT_EQ(controller.speed_reference(), 2.0) << "the new limit holds the received 10 m/s";
+  CmdVelControllerSettings bad = controller.settings();
+  bad.min_acceleration = 0.0;
+  EXPECT_THROW(controller.set_settings(bad), std::invalid_argument);
+  CmdVelControllerSettings longer = controller.settings();
+  longer.wheel_separation_h = 2.0;
+  try {
+    controller.set_settings(longer);
+    ADD_FAILURE() << "a new wheel_separation_h was accepted while running";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("wheel_separation_h"), std::string::npos) << error.what();
+  }
+  EXPECT_EQ(controller.settings().min_acceleration, -3.0);
+  EXPECT_EQ(controller.settings().wheel_separation_h, 1.05);
+  EXPECT_EQ(controller.settings().max_velocity, 2.0);
+}
+
 // ---------------------------------------------------------------------------------------------
 // The closed loop: driven.yaml (torques from commands) stepped by the core, the law updated at every
 // 10 ms instant with the state of that instant, its torques held until the next one (as cart_sim's

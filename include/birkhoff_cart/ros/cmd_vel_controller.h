@@ -88,6 +88,10 @@ class CmdVelController {
   void restart(const CartFeedback& feedback);
 
   const CmdVelControllerSettings& settings() const { return settings_; }
+  /// New limits, gains and timeout while running (dynamic_reconfigure); the command, references
+  /// and integral carry on. Throws std::invalid_argument (validate()) and keeps the old settings
+  /// for a bad set, or for a new wheel_separation_h: the cart's geometry is not a tuning knob.
+  void set_settings(const CmdVelControllerSettings& settings);
   bool timed_out() const { return timed_out_; }             ///< the last update ran on the (0, 0) fallback
   std::uint64_t timeouts() const { return timeouts_; }      ///< times the command fell to (0, 0)
   double speed_reference() const { return speed_reference_; }           ///< v_ref after limits [m/s]

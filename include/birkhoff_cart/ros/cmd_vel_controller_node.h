@@ -12,6 +12,8 @@
 // /use_sim_time is false.
 #pragma once
 
+#include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -19,7 +21,11 @@
 #include <geometry_msgs/Twist.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include <boost/thread/recursive_mutex.hpp>
+#include <dynamic_reconfigure/server.h>
 #include <sensor_msgs/JointState.h>
+
+#include "birkhoff_cart/CmdVelControllerConfig.h"
 
 #include "birkhoff_cart/ros/cmd_vel_controller.h"
 
@@ -44,6 +50,8 @@ class CmdVelControllerNode {
  private:
   /// Refuses (ROS_FATAL, ros::shutdown) when joint_states has come for kJointGrace without the joint.
   void check_joint_names(const ros::WallTimerEvent&);
+  /// A dynamic_reconfigure request: the new limits and gains, or a refusal by name (old ones kept).
+  void on_reconfigure(CmdVelControllerConfig& config, std::uint32_t level);
   void on_cmd_vel(const geometry_msgs::Twist::ConstPtr& message);
   void on_odometry(const nav_msgs::Odometry::ConstPtr& message);
   void on_joint_states(const sensor_msgs::JointState::ConstPtr& message);
@@ -74,6 +82,10 @@ class CmdVelControllerNode {
   std::vector<std::string> names_without_joint_;      ///< the joint names that message held
   ros::WallTimer joint_check_;
   std::string refusal_;
+  /// The server's mutex, ours so that updateConfig() at start-up is safe (the server warns otherwise).
+  boost::recursive_mutex reconfigure_mutex_;
+  /// ~set_parameters etc. (cfg/CmdVelController.cfg): what may change while running.
+  std::unique_ptr<dynamic_reconfigure::Server<CmdVelControllerConfig>> reconfigure_server_;
 };
 
 }  // namespace birkhoff_cart
