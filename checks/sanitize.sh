@@ -57,7 +57,7 @@ mkdir -p "$workspace/src"
 [ -L "$workspace/src/birkhoff_cart" ] || ln -sfn "$repo" "$workspace/src/birkhoff_cart"
 # -Wno-maybe-uninitialized: with -fsanitize=address GCC 12 reports false "may be used
 # uninitialized" inside libstdc++'s std::regex / std::function, and the package builds with -Werror.
-flags="-fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all -fno-omit-frame-pointer -g -O1"
+flags="-fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all -fno-omit-frame-pointer -g1 -O1"
 [ "$compiler" = gcc ] && flags="$flags -Wno-maybe-uninitialized"
 
 unit_tests=()
