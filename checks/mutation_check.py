@@ -208,6 +208,17 @@ def find_binary(build: pathlib.Path, target: str) -> pathlib.Path:
     return found[0]
 
 
+def require_scratch_library(build: pathlib.Path, binary: pathlib.Path):
+    """Exits unless `binary` loads the scratch build's libbirkhoff_cart_core.so. The test binaries
+    find it through RUNPATH, which LD_LIBRARY_PATH overrides: under a caller that sourced another
+    workspace's devel/setup.bash, a mutation of the library's .cpp files would be tested against
+    that workspace's pristine library and survive. main() puts the scratch library first."""
+    status, listing = run(["ldd", str(binary)])
+    expected = f"libbirkhoff_cart_core.so => {build / 'devel/lib'}/"
+    if status != 0 or (expected not in listing and "libbirkhoff_cart_core.so" in listing):
+        sys.exit(f"mutation_check: {binary.name} does not load the scratch library ({expected}...):\n{listing}")
+
+
 def build_and_run(build: pathlib.Path, tests, log):
     """Builds the targets of `tests` and runs each; returns (built, [failing tests], [passing tests])."""
     targets = sorted({target for target, _ in tests})
@@ -216,7 +227,9 @@ def build_and_run(build: pathlib.Path, tests, log):
         return False, [], []
     failing, passing = [], []
     for target, gtest_filter in tests:
-        status, output = run([str(find_binary(build, target)), f"--gtest_filter={gtest_filter}"], log=log)
+        binary = find_binary(build, target)
+        require_scratch_library(build, binary)
+        status, output = run([str(binary), f"--gtest_filter={gtest_filter}"], log=log)
         label = f"{target} --gtest_filter={gtest_filter}"
         (failing if status != 0 else passing).append(label)
     return True, failing, passing
@@ -311,6 +324,8 @@ def main() -> int:
     environment_path = "/usr/bin:/bin:" + os.environ.get("PATH", "")
     os.environ["PATH"] = environment_path
     os.environ.setdefault("CCACHE_BASEDIR", str(scratch))
+    library_path = os.environ.get("LD_LIBRARY_PATH")
+    os.environ["LD_LIBRARY_PATH"] = str(build / "devel/lib") + (":" + library_path if library_path else "")
     if not (build / "Makefile").is_file():
         build.mkdir(parents=True, exist_ok=True)
         launcher = ["-DCMAKE_CXX_COMPILER_LAUNCHER=ccache"] if shutil.which("ccache") else []

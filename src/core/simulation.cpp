@@ -47,7 +47,8 @@ Simulation::Simulation(const Scene& scene)
       effects_(build_effects(scene.effects, model_)),
       stepper_(make_cart_stepper(integrator_settings(scene), model_, effects_)),
       state_(scene.initial_state),
-      schedule_(plan_steps(scene.initial_state.time, scene.duration, scene.integrator.step_size)) {
+      schedule_(plan_steps(scene.initial_state.time, scene.duration, scene.integrator.step_size)),
+      loaded_initial_state_(scene.initial_state) {
   stepper_->prepare(state_, statistics_);  // the reversible control's pilots; refuses an unreachable tolerance
   initial_energy_ = model_.energy(state_);
   initial_steering_momentum_ = model_.steering_momentum(state_);
@@ -110,6 +111,14 @@ void Simulation::advance_to(double time) {
 }
 
 void Simulation::reset() {
+  if (restarted_) {  // undo restart_from(): the loaded scene's state, schedule and reference
+    scene_.initial_state = loaded_initial_state_;
+    schedule_ = plan_steps(scene_.initial_state.time, scene_.duration, scene_.integrator.step_size);
+    reference_ = make_reference_solution(scene_, model_, effects_);
+    restarted_ = false;
+    initial_energy_ = model_.energy(scene_.initial_state);
+    initial_steering_momentum_ = model_.steering_momentum(scene_.initial_state);
+  }
   stepper_ = make_cart_stepper(integrator_settings(scene_), model_, effects_);  // forgets adaptive step-size guesses
   state_ = scene_.initial_state;
   steps_taken_ = 0;
@@ -119,6 +128,49 @@ void Simulation::reset() {
   if (reference_) reference_->reset();
   if (effects_.steering_command()) effects_.steering_command()->value = initial_command(scene_, "steering_torque");
   if (effects_.drive_command()) effects_.drive_command()->value = initial_command(scene_, "drive_torque");
+}
+
+void Simulation::restart_from(const CartState& initial_state) {
+  const CartState& s = initial_state;
+  const double fields[] = {s.time, s.x, s.y, s.heading, s.steering_angle, s.arc_length, s.forward_speed,
+                           s.steering_rate, s.wheel_spin_angle[0], s.wheel_spin_angle[1], s.wheel_spin_angle[2],
+                           s.wheel_spin_angle[3]};
+  const char* names[] = {"time", "x", "y", "heading", "steering_angle", "arc_length", "forward_speed",
+                         "steering_rate", "wheel_spin_angle[0]", "wheel_spin_angle[1]", "wheel_spin_angle[2]",
+                         "wheel_spin_angle[3]"};
+  for (std::size_t i = 0; i < sizeof(fields) / sizeof(fields[0]); ++i) {
+    if (!std::isfinite(fields[i])) {
+      std::ostringstream message;
+      message << "restart state: " << names[i] << " must be finite, got " << fields[i];
+      throw std::invalid_argument(message.str());
+    }
+  }
+  // Everything that can refuse is built before anything changes.
+  Scene restarted = scene_;
+  restarted.initial_state = initial_state;
+  StepSchedule schedule = plan_steps(initial_state.time, scene_.duration, scene_.integrator.step_size);
+  try {
+    check_singular_steering(model_, initial_state, scene_.integrator.step_size);
+  } catch (const StepError& error) {
+    throw std::invalid_argument(std::string("restart state: ") + error.what());
+  }
+  std::unique_ptr<ReferenceSolution> reference = make_reference_solution(restarted, model_, effects_);
+  std::unique_ptr<CartStepper> stepper = make_cart_stepper(integrator_settings(restarted), model_, effects_);
+  StepStatistics statistics;
+  CartState state = initial_state;
+  stepper->prepare(state, statistics);  // the reversible control's pilots may refuse the new state
+  // Commit: nothing below throws.
+  scene_ = std::move(restarted);
+  schedule_ = schedule;
+  reference_ = std::move(reference);
+  stepper_ = std::move(stepper);
+  state_ = state;
+  statistics_ = statistics;
+  steps_taken_ = 0;
+  finished_off_grid_ = false;
+  initial_energy_ = model_.energy(state_);
+  initial_steering_momentum_ = model_.steering_momentum(state_);
+  restarted_ = true;
 }
 
 bool Simulation::accepts_steering_command() const { return static_cast<bool>(effects_.steering_command()); }

@@ -67,6 +67,7 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   } else {
     run_duration_ = parameters_.duration;
   }
+  loaded_start_time_ = start_time;
   end_time_ = std::numeric_limits<double>::infinity();
   if (std::isfinite(run_duration_)) {
     // The same plan as cart_simulate's (the scene's own duration was already checked by Simulation).
@@ -184,6 +185,16 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   }
   reset_service_ = private_node_.advertiseService("reset", &CartSimNode::on_reset, this);
   pause_service_ = private_node_.advertiseService("pause", &CartSimNode::on_pause, this);
+  set_state_service_ = private_node_.advertiseService("set_state", &CartSimNode::on_set_state, this);
+  initial_pose_subscriber_ = node_.subscribe("initialpose", 5, &CartSimNode::on_initial_pose, this);
+  {
+    ros::AdvertiseServiceOptions options = ros::AdvertiseServiceOptions::create<StepRun>(
+        "step", [this](StepRun::Request& request, StepRun::Response& response) { return on_step(request, response); },
+        ros::VoidConstPtr(), &step_queue_);
+    step_service_ = private_node_.advertiseService(options);
+    step_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &step_queue_);
+    step_spinner_->start();
+  }
 
   diagnostic_updater_ = std::make_unique<diagnostic_updater::Updater>(node_, private_node_);
   diagnostic_updater_->setHardwareID("birkhoff_cart/" + simulation_->scene().name);
@@ -215,8 +226,13 @@ void CartSimNode::restart_schedule() {
   if (simulation_->steps_taken() != 0) {
     throw std::logic_error("cart_sim: the run's schedule is planned only at the scene's start");
   }
+  // From the current time to the run's end: the whole run after construction or ~reset, the rest of
+  // it after a teleport (~set_state, /initialpose).
   const double start_time = simulation_->state().time;
-  if (std::isfinite(run_duration_)) schedule_ = plan_steps(start_time, run_duration_, simulation_->step_size());
+  const bool whole_run = start_time == loaded_start_time_;
+  if (std::isfinite(end_time_)) {
+    schedule_ = plan_steps(start_time, whole_run ? run_duration_ : end_time_ - start_time, simulation_->step_size());
+  }
   next_publish_index_ = 1;
   next_diagnostic_index_ = 1;
   clock_started_ = false;
@@ -249,6 +265,7 @@ bool CartSimNode::take_step() {
     step_failure_ = error.what();
     return false;
   }
+  count_requested_step();
   ++period_steps_;
   ++total_steps_;
   simulated_time_ += simulation_->state().time - time_before;
@@ -266,14 +283,15 @@ bool CartSimNode::take_step() {
 
 int CartSimNode::run_loop(std::string& outcome) {
   using Clock = WallClockPacing::Clock;
-  const double start = simulation_->scene().initial_state.time;
   while (true) {
+    // The run's start: the scene's t0, or the time of the last teleport (~set_state, /initialpose).
+    const double start = simulation_->scene().initial_state.time;
     if (stop_requested()) {
       outcome = "interrupted (shutdown requested)";
       break;
     }
     if (record_failure_) break;  // a command could not be recorded (set in a callback, also while paused)
-    if (paused_) {
+    if (halted()) {
       wait_while_paused();
       continue;
     }
@@ -286,28 +304,34 @@ int CartSimNode::run_loop(std::string& outcome) {
     if (parameters_.follow_clock) {  // the batch runs once the leader's /clock has reached its end
       const std::uint64_t resets_before = resets_;
       wait_for_clock(std::min(instant, end_time_));
-      if (paused_ || record_failure_ || stop_requested() || resets_ != resets_before) continue;
+      if (halted() || record_failure_ || stop_requested() || resets_ != resets_before) continue;
     }
     Clock::time_point batch_start = Clock::now();
     bool failed = false;
     bool interrupted = false;
     double due_scene_time = -std::numeric_limits<double>::infinity();  // [s]
+    // Steps asked for by ~step while paused run as fast as they can (not paced).
+    const bool paced = pacing_.paced() && !paused_;
     while (!end_reached() && simulation_->state().time + half_step < instant) {
+      if (halted()) {  // the ~step request is done (its last step was not on an instant)
+        interrupted = true;
+        break;
+      }
       // Real time: a step is due once the wall clock has reached its scene time (half a step early
       // is fine). Steps due are run back to back; only a node that has caught up runs callbacks or
       // sleeps, so a command takes effect at the first step after its arrival in scene time too.
       const double next_time = next_step_time();
       // The scene time due by now is read from the clock only when the last reading no longer
       // covers the next step (one clock read per catch-up, not per step).
-      if (pacing_.paced() && due_scene_time < next_time - half_step) {
+      if (paced && due_scene_time < next_time - half_step) {
         due_scene_time = pacing_.scene_time_at(Clock::now());
       }
-      const bool step_due = !pacing_.paced() || due_scene_time >= next_time - half_step;
-      if ((!step_due || !pacing_.paced()) && !parameters_.lockstep && callback_queue_.pending()) {
+      const bool step_due = !paced || due_scene_time >= next_time - half_step;
+      if ((!step_due || !paced) && !parameters_.lockstep && callback_queue_.pending()) {
         const std::uint64_t resets_before = resets_;
         process_callbacks();
-        if (paused_ || record_failure_ || stop_requested() || resets_ != resets_before) {
-          interrupted = true;  // paused, failed, stopping, or reset (time went back): a new batch
+        if (halted() || record_failure_ || stop_requested() || resets_ != resets_before) {
+          interrupted = true;  // paused, failed, stopping, reset or teleported: a new batch
           break;
         }
         if (!step_due) continue;
@@ -318,7 +342,7 @@ int CartSimNode::run_loop(std::string& outcome) {
         period_stepping_wall_time_ += elapsed;
         wait_until_due(std::min(instant, end_time_));
         batch_start = Clock::now();
-        if (paused_ || record_failure_ || stop_requested()) {
+        if (halted() || record_failure_ || stop_requested()) {
           interrupted = true;
           break;
         }
@@ -361,6 +385,7 @@ int CartSimNode::run() {
     // closed, exit 4; never std::terminate with the record left unfinished.
     internal_error = error.what();
   }
+  end_step_requests();
 
   if (!internal_error && !step_failure_ && !record_failure_ && !stop_requested()) {
     // publish() only queues a message for roscpp's transport threads: give them a moment to send

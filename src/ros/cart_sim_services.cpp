@@ -53,19 +53,23 @@ void CartSimNode::on_drive_torque(const std_msgs::Float64::ConstPtr& message) {
   simulation_->set_drive_command(drive_channel_->torque());
 }
 
+void CartSimNode::restart_commands(double time) {
+  if (steering_channel_) {
+    steering_channel_->restart(time);
+    simulation_->set_steering_command(steering_channel_->torque());
+  }
+  if (drive_channel_) {
+    drive_channel_->restart(time);
+    simulation_->set_drive_command(drive_channel_->torque());
+  }
+}
+
 bool CartSimNode::on_reset(std_srvs::Empty::Request& /*request*/, std_srvs::Empty::Response& /*response*/) {
   simulation_->reset();
   accuracy_guard_.reset();
   ++resets_;
   const double start_time = simulation_->state().time;
-  if (steering_channel_) {
-    steering_channel_->restart(start_time);
-    simulation_->set_steering_command(steering_channel_->torque());
-  }
-  if (drive_channel_) {
-    drive_channel_->restart(start_time);
-    simulation_->set_drive_command(drive_channel_->torque());
-  }
+  restart_commands(start_time);
   restart_schedule();
   // Each run gets its own bag: one bag across a reset would hold overlapping times of two runs,
   // which playback interleaves.

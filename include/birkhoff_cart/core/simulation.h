@@ -61,8 +61,18 @@ class Simulation {
   /// off the step grid (the paper's case runs from π/2 to 3.0). Afterwards the run is over:
   /// step() throws std::logic_error until reset(). Throws std::invalid_argument for a bad time.
   void step_to(double time);
-  /// Back to the scene's initial state, counters and reference included.
+  /// Back to the scene's initial state, counters and reference included (also after restart_from():
+  /// the loaded scene's state, time and schedule).
   void reset();
+  /// A new run from `initial_state` at its own time t₀' (a teleport: the caller passes the current
+  /// time to keep time continuous). Restarts like reset(): the step memory, the counters, the
+  /// reference (rebuilt from the new state) and the invariants' initial values; the schedule is
+  /// t₀' + the scene's duration; commands keep their values. Refuses, leaving everything as it was,
+  /// with std::invalid_argument naming the problem: a non-finite field, a state where the next step
+  /// would meet a singular steering angle (the paper's special case at χ = kπ, docs/hard_cases.md §1),
+  /// a reference that cannot start there (paper_analytic off its analytic state), a time beyond the
+  /// limits of step_schedule.h.
+  void restart_from(const CartState& initial_state);
 
   /// Command inputs (zero-order hold). Throw std::invalid_argument for a non-finite torque and
   /// std::logic_error when the scene's effect does not take commands.
@@ -78,16 +88,18 @@ class Simulation {
   const StepStatistics& statistics() const { return statistics_; }
 
  private:
-  Scene scene_;
+  Scene scene_;  ///< the run's scene: the loaded one, or with its restart_from() state
   CartModel model_;
   EffectSet effects_;
   std::unique_ptr<CartStepper> stepper_;
   CartState state_;
   StepSchedule schedule_;
+  CartState loaded_initial_state_;  ///< the loaded scene's initial state, for reset()
   void take_step(double step_size, double next_time);
 
   std::uint64_t steps_taken_ = 0;
   bool finished_off_grid_ = false;  ///< step_to() left the grid t₀ + n h
+  bool restarted_ = false;          ///< restart_from() replaced the loaded initial state
   StepStatistics statistics_;
   double initial_energy_ = 0.0;
   double initial_steering_momentum_ = 0.0;

@@ -17,10 +17,12 @@
 //
 // The member functions are defined by job: cart_sim_node.cpp (construction and the time loop),
 // cart_sim_pacing.cpp (callbacks, real-time deadlines, the lockstep barrier), cart_sim_publishing.cpp,
-// cart_sim_services.cpp (commands, ~reset, ~pause) and cart_sim_summary.cpp (diagnostics, summary).
+// cart_sim_services.cpp (commands, ~reset, ~pause), cart_sim_teleport.cpp (~set_state, /initialpose,
+// ~step) and cart_sim_summary.cpp (diagnostics, summary).
 #pragma once
 
 #include <atomic>
+#include <condition_variable>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -29,13 +31,17 @@
 #include <vector>
 
 #include <diagnostic_updater/diagnostic_updater.h>
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <ros/ros.h>
+#include <ros/spinner.h>
 #include <std_msgs/Float64.h>
 #include <std_srvs/Empty.h>
 #include <std_srvs/SetBool.h>
 #include <rosgraph_msgs/Clock.h>
 
 #include "birkhoff_cart/core/accuracy_guard.h"
+#include "birkhoff_cart/SetCartState.h"
+#include "birkhoff_cart/StepRun.h"
 #include "birkhoff_cart/core/simulation.h"
 #include "birkhoff_cart/ros/bag_recorder.h"
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
@@ -86,6 +92,24 @@ class CartSimNode {
   bool on_reset(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   bool on_pause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
   void open_record(const std::string& path);
+  /// The command channels' hold and watchdogs start again at scene time `time` [s] (~reset, teleports).
+  void restart_commands(double time);
+
+  // cart_sim_teleport.cpp
+  bool on_set_state(SetCartState::Request& request, SetCartState::Response& response);
+  void on_initial_pose(const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& message);
+  /// Restarts the run from `target` at the current time (Simulation::restart_from) and restarts the
+  /// commands' hold, the accuracy guard, the schedule and the publish instants there; the bag goes
+  /// on. False, with `message` naming the problem and nothing changed, when it is refused.
+  bool teleport(const CartState& target, const std::string& source, std::string& message);
+  /// Served on its own thread (step_queue_): waits until the run loop has taken the steps.
+  bool on_step(StepRun::Request& request, StepRun::Response& response);
+  /// Paused with no ~step request open: the loop waits.
+  bool halted() const { return paused_ && steps_requested_ == 0; }
+  /// After a step: counts it against an open ~step request and wakes its caller when done.
+  void count_requested_step();
+  /// The loop has ended: an open ~step request returns with the steps taken.
+  void end_step_requests();
 
   // cart_sim_node.cpp
   /// Plans the run from the current state (construction, ~reset: the simulation's step count is 0)
@@ -158,17 +182,29 @@ class CartSimNode {
   ros::Subscriber drive_subscriber_;
   ros::ServiceServer reset_service_;
   ros::ServiceServer pause_service_;
+  ros::ServiceServer set_state_service_;
+  ros::Subscriber initial_pose_subscriber_;
+  ros::CallbackQueue step_queue_;  ///< ~step alone: its call blocks until the loop has taken the steps
+  ros::ServiceServer step_service_;
+  std::unique_ptr<ros::AsyncSpinner> step_spinner_;
+  std::mutex step_mutex_;
+  std::condition_variable step_condition_;
+  std::atomic<std::uint64_t> steps_requested_{0};  ///< steps of the open ~step request not yet taken
+  bool step_request_open_ = false;  ///< guarded by step_mutex_
+  bool loop_over_ = false;          ///< guarded by step_mutex_
+  double stepped_to_time_ = 0.0;    ///< scene time after the last requested step [s]; guarded by step_mutex_
   std::unique_ptr<diagnostic_updater::Updater> diagnostic_updater_;
 
   double run_duration_ = 0.0;             ///< T: the run's length from its start [s]; +inf = without end
   std::optional<StepSchedule> schedule_;  ///< how the run is cut into steps (step_schedule.h); none without end
   double end_time_ = 0.0;                 ///< t0 + T, where the run stops exactly [s]; +inf = never
+  double loaded_start_time_ = 0.0;        ///< the scene's t0 [s] (a teleport starts the run's rest elsewhere)
   double publish_period_ = 0.01;          ///< [s]
   WallClockPacing pacing_;
   std::uint64_t next_publish_index_ = 1;  ///< k of the next publish instant t0 + k/publish_rate
   std::uint64_t next_diagnostic_index_ = 1;
   bool clock_started_ = false;            ///< the first /clock (t0 + h) went out
-  bool paused_ = false;
+  std::atomic<bool> paused_{false};  ///< read by the ~step thread
   std::uint64_t resets_ = 0;              ///< ~reset calls served
   ros::Time last_transform_stamp_;        ///< never the same tf stamp twice
   std::optional<std::string> step_failure_;

@@ -1,0 +1,163 @@
+// cart_sim's pose and time control: ~set_state and /initialpose teleport the cart (a restart of the
+// run from the new state at the current scene time), ~step advances a paused run by N steps.
+#include <cmath>
+#include <sstream>
+
+#include <tf2/utils.h>
+
+#include "birkhoff_cart/ros/cart_sim_node.h"
+
+namespace birkhoff_cart {
+namespace {
+
+/// The hinge B of a cart whose base_link (rear-axle midpoint A) is at (x, y) with heading θ:
+/// B = A + l (cos θ, sin θ), the inverse of CartModel::rear_axle_midpoint (docs/model.md).
+void place_hinge(CartState& state, double base_x, double base_y, double heading, double wheelbase) {
+  state.heading = heading;
+  state.x = base_x + wheelbase * std::cos(heading);  // [m]
+  state.y = base_y + wheelbase * std::sin(heading);  // [m]
+}
+
+}  // namespace
+
+bool CartSimNode::teleport(const CartState& target, const std::string& source, std::string& message) {
+  if (end_reached()) {
+    message = source + " refused: the run has ended at t = " + format_seconds(simulation_->state().time) + " s";
+    ROS_ERROR("cart_sim: %s", message.c_str());
+    return false;
+  }
+  try {
+    simulation_->restart_from(target);
+  } catch (const std::invalid_argument& error) {
+    message = source + " refused: " + error.what() + "; the simulation goes on unchanged";
+    ROS_ERROR("cart_sim: %s", message.c_str());
+    return false;
+  }
+  accuracy_guard_.reset();
+  ++resets_;  // a batch in progress stops: its publish instants belonged to the old start
+  const double time = simulation_->state().time;
+  restart_commands(time);
+  restart_schedule();
+  const Eigen::Vector2d base = simulation_->model().rear_axle_midpoint(target);
+  std::ostringstream text;
+  text << source << ": teleported at t = " << format_seconds(time) << " s to base_link (" << base.x() << ", "
+       << base.y() << ") m, heading " << target.heading << " rad, steering angle " << target.steering_angle
+       << " rad, forward speed " << target.forward_speed << " m/s, steering rate " << target.steering_rate
+       << " rad/s (a restart of the run from there" << (recorder_ ? "; the bag goes on)" : ")");
+  message = text.str();
+  ROS_INFO("cart_sim: %s", message.c_str());
+  return true;
+}
+
+bool CartSimNode::on_set_state(SetCartState::Request& request, SetCartState::Response& response) {
+  const std::pair<const char*, double> fields[] = {
+      {"x", request.x}, {"y", request.y}, {"heading", request.heading}, {"steering_angle", request.steering_angle},
+      {"forward_speed", request.forward_speed}, {"steering_rate", request.steering_rate}};
+  for (const auto& [name, value] : fields) {
+    if (!std::isfinite(value)) {
+      std::ostringstream text;
+      text << "~set_state refused: " << name << " must be finite, got " << value << "; the simulation goes on unchanged";
+      response.success = false;
+      response.message = text.str();
+      ROS_ERROR("cart_sim: %s", response.message.c_str());
+      return true;
+    }
+  }
+  CartState target = simulation_->state();  // keeps the time, the wheel spin angles and the arc length
+  place_hinge(target, request.x, request.y, request.heading, simulation_->model().parameters().wheelbase);
+  target.steering_angle = request.steering_angle;
+  target.forward_speed = request.forward_speed;
+  target.steering_rate = request.steering_rate;
+  response.success = teleport(target, "~set_state", response.message);
+  return true;
+}
+
+void CartSimNode::on_initial_pose(const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& message) {
+  const std::string& frame = message->header.frame_id;
+  if (!frame.empty() && frame != parameters_.frames.odom) {
+    ROS_ERROR("cart_sim: %s refused: the pose is in frame '%s', cart_sim places the cart in '%s' (set rviz's "
+              "fixed frame to it); the simulation goes on unchanged",
+              initial_pose_subscriber_.getTopic().c_str(), frame.c_str(), parameters_.frames.odom.c_str());
+    return;
+  }
+  const geometry_msgs::Pose& pose = message->pose.pose;
+  const double values[] = {pose.position.x, pose.position.y, pose.orientation.x, pose.orientation.y,
+                           pose.orientation.z, pose.orientation.w};
+  for (double value : values) {
+    if (!std::isfinite(value)) {
+      ROS_ERROR("cart_sim: %s refused: a non-finite pose field (%g); the simulation goes on unchanged",
+                initial_pose_subscriber_.getTopic().c_str(), value);
+      return;
+    }
+  }
+  const double norm = std::sqrt(pose.orientation.x * pose.orientation.x + pose.orientation.y * pose.orientation.y +
+                                pose.orientation.z * pose.orientation.z + pose.orientation.w * pose.orientation.w);
+  if (!(norm > 1e-6)) {
+    ROS_ERROR("cart_sim: %s refused: the orientation quaternion has norm %g; the simulation goes on unchanged",
+              initial_pose_subscriber_.getTopic().c_str(), norm);
+    return;
+  }
+  tf2::Quaternion orientation(pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w);
+  orientation.normalize();
+  // Like rviz's 2D Pose Estimate on a robot at rest: the pose is set, the cart stands still, the
+  // steering angle stays.
+  CartState target = simulation_->state();
+  place_hinge(target, pose.position.x, pose.position.y, tf2::getYaw(orientation),
+              simulation_->model().parameters().wheelbase);
+  target.forward_speed = 0.0;
+  target.steering_rate = 0.0;
+  std::string text;
+  teleport(target, initial_pose_subscriber_.getTopic(), text);
+}
+
+bool CartSimNode::on_step(StepRun::Request& request, StepRun::Response& response) {
+  std::unique_lock<std::mutex> lock(step_mutex_);
+  const auto refuse = [&response](const std::string& why) {
+    response.success = false;
+    response.steps_taken = 0;
+    response.message = "~step refused: " + why;
+    ROS_ERROR("cart_sim: %s", response.message.c_str());
+    return true;
+  };
+  if (parameters_.lockstep) return refuse("~lockstep is on: the controllers' answers pace the run");
+  if (parameters_.follow_clock) return refuse("~follow_clock is on: the leader's /clock paces the run");
+  if (!paused_) return refuse("the run is not paused (call ~pause with data: true first)");
+  if (request.steps == 0) return refuse("steps must be at least 1");
+  if (step_request_open_) return refuse("another ~step call is being served");
+  if (loop_over_) return refuse("the run has ended");
+  step_request_open_ = true;
+  steps_requested_ = request.steps;
+  callback_queue_.wake();
+  // The loop takes the steps on its own thread; wait for it (and not forever on a node going down).
+  while (steps_requested_ > 0 && !loop_over_ && ros::ok()) {
+    step_condition_.wait_for(lock, std::chrono::milliseconds(100));
+  }
+  const std::uint64_t remaining = steps_requested_.exchange(0);
+  step_request_open_ = false;
+  response.steps_taken = static_cast<std::uint32_t>(request.steps - remaining);
+  response.time = stepped_to_time_;
+  response.success = remaining == 0;
+  response.message = (response.success ? "took " : "ran out after ") + std::to_string(response.steps_taken) +
+                     " of " + std::to_string(request.steps) + " steps; t = " + format_seconds(stepped_to_time_) +
+                     " s" + (response.success ? ", paused" : " (the run ended or a step failed)");
+  if (!response.success) ROS_WARN("cart_sim: ~step %s", response.message.c_str());
+  return true;
+}
+
+void CartSimNode::count_requested_step() {
+  if (steps_requested_.load(std::memory_order_relaxed) == 0) return;  // one load per step otherwise
+  std::lock_guard<std::mutex> lock(step_mutex_);
+  stepped_to_time_ = simulation_->state().time;
+  if (steps_requested_ > 0 && --steps_requested_ == 0) step_condition_.notify_all();
+}
+
+void CartSimNode::end_step_requests() {
+  {
+    std::lock_guard<std::mutex> lock(step_mutex_);
+    loop_over_ = true;
+    stepped_to_time_ = simulation_->state().time;
+  }
+  step_condition_.notify_all();
+}
+
+}  // namespace birkhoff_cart

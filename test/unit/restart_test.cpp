@@ -1,0 +1,139 @@
+// Simulation::restart_from(): a teleport is a restart of the run from the given state (the node's
+// ~set_state and /initialpose). The restarted run must be the run of a scene that starts there, bit
+// for bit; reset() must still return to the loaded scene; every refusal leaves the run as it was.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <string>
+
+#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/simulation.h"
+
+namespace birkhoff_cart {
+namespace {
+
+Scene load(const std::string& name) {
+  return load_scene(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/" + name + ".yaml");
+}
+
+bool bit_identical(const CartState& a, const CartState& b) { return std::memcmp(&a, &b, sizeof(CartState)) == 0; }
+
+/// A state away from the scene's: another pose, steering angle and speeds, at time `time` [s].
+CartState teleport_target(double time) {
+  CartState target;
+  target.time = time;
+  target.x = 3.0;              // [m]
+  target.y = -1.5;             // [m]
+  target.heading = 0.7;        // [rad]
+  target.steering_angle = -0.4;  // [rad]
+  target.forward_speed = 1.2;  // [m/s]
+  target.steering_rate = 0.3;  // [rad/s]
+  return target;
+}
+
+TEST(Restart, TheRestartedRunIsTheRunOfASceneStartingThereBitForBit) {
+  for (const std::string integrator : {"birkhoff_gauss4", "birkhoff2", "dopri5"}) {
+    Scene scene = load("default");  // shadow reference on
+    scene.integrator.name = integrator;
+    Simulation simulation(scene);
+    for (int k = 0; k < 250; ++k) simulation.step();
+    const CartState target = teleport_target(simulation.state().time);
+    simulation.restart_from(target);
+    EXPECT_TRUE(bit_identical(simulation.state(), target)) << integrator;
+    EXPECT_EQ(simulation.steps_taken(), 0u) << integrator;
+    EXPECT_EQ(simulation.statistics().rhs_evaluations, 0u) << integrator;
+    EXPECT_EQ(simulation.diagnostics().reference_position_error, 0.0) << integrator;  // reference restarted there
+    EXPECT_EQ(simulation.diagnostics().energy_balance_residual, 0.0) << integrator;
+
+    Scene starting_there = scene;
+    starting_there.initial_state = target;
+    Simulation fresh(starting_there);
+    for (int k = 0; k < 400; ++k) {
+      simulation.step();
+      fresh.step();
+    }
+    EXPECT_TRUE(bit_identical(simulation.state(), fresh.state())) << integrator;
+    EXPECT_EQ(simulation.statistics().rhs_evaluations, fresh.statistics().rhs_evaluations) << integrator;
+    EXPECT_EQ(simulation.diagnostics().reference_position_error, fresh.diagnostics().reference_position_error)
+        << integrator;
+    EXPECT_GT(simulation.diagnostics().reference_position_error, 0.0) << integrator;  // a real comparison
+    EXPECT_EQ(simulation.schedule().end_time, fresh.schedule().end_time) << integrator;
+  }
+}
+
+TEST(Restart, ResetAfterARestartReturnsToTheLoadedScene) {
+  Scene scene = load("driven");
+  Simulation loaded(scene);
+  for (int k = 0; k < 300; ++k) loaded.step();
+
+  Simulation simulation(scene);
+  for (int k = 0; k < 100; ++k) simulation.step();
+  simulation.restart_from(teleport_target(simulation.state().time));
+  for (int k = 0; k < 100; ++k) simulation.step();
+  simulation.reset();
+  EXPECT_TRUE(bit_identical(simulation.state(), scene.initial_state));
+  EXPECT_EQ(simulation.schedule().end_time, loaded.schedule().end_time);
+  for (int k = 0; k < 300; ++k) simulation.step();
+  EXPECT_TRUE(bit_identical(simulation.state(), loaded.state()));
+  EXPECT_EQ(simulation.diagnostics().energy_balance_residual, loaded.diagnostics().energy_balance_residual);
+}
+
+/// Expects restart_from(`target`) to throw std::invalid_argument naming `expected`, and the run to
+/// go on exactly as if it had not been asked.
+void expect_refused(const Scene& scene, const CartState& target, const std::string& expected) {
+  Simulation simulation(scene);
+  Simulation untouched(scene);
+  for (int k = 0; k < 50; ++k) {
+    simulation.step();
+    untouched.step();
+  }
+  try {
+    simulation.restart_from(target);
+    ADD_FAILURE() << "accepted a restart that should name '" << expected << "'";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find(expected), std::string::npos) << error.what();
+  }
+  EXPECT_TRUE(bit_identical(simulation.state(), untouched.state())) << expected;
+  EXPECT_EQ(simulation.steps_taken(), untouched.steps_taken()) << expected;
+  for (int k = 0; k < 50; ++k) {
+    simulation.step();
+    untouched.step();
+  }
+  EXPECT_TRUE(bit_identical(simulation.state(), untouched.state())) << expected;
+  const double error = simulation.diagnostics().reference_position_error;  // [m]; NaN without a reference
+  const double untouched_error = untouched.diagnostics().reference_position_error;
+  EXPECT_TRUE(error == untouched_error || (std::isnan(error) && std::isnan(untouched_error))) << expected;
+}
+
+TEST(Restart, RefusesByNameAndLeavesTheRunUntouched) {
+  const Scene scene = load("default");
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  CartState target = teleport_target(0.05);
+  target.x = nan;
+  expect_refused(scene, target, "x must be finite");
+  target = teleport_target(0.05);
+  target.steering_angle = std::numeric_limits<double>::infinity();
+  expect_refused(scene, target, "steering_angle must be finite");
+  target = teleport_target(0.05);
+  target.steering_rate = nan;
+  expect_refused(scene, target, "steering_rate must be finite");
+  target = teleport_target(1e300);
+  expect_refused(scene, target, "");  // a time beyond the schedule's limits (named by step_schedule.h)
+
+  // The paper's special case: M(χ) is singular at χ = kπ (docs/hard_cases.md §1).
+  Scene paper = load("paper_special");
+  paper.reference.kind = ReferenceSettings::Kind::kNone;
+  target = paper.initial_state;
+  target.time += 0.05;
+  target.steering_angle = M_PI;
+  expect_refused(paper, target, "singular steering angle");
+  // Its analytic reference exists only on the analytic solution.
+  target = load("paper_special").initial_state;
+  target.forward_speed = 2.0;
+  expect_refused(load("paper_special"), target, "paper_analytic");
+}
+
+}  // namespace
+}  // namespace birkhoff_cart
