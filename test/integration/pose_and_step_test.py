@@ -2,10 +2,12 @@
 """rostest pose_and_step: cart_sim's ~step, ~set_state and /initialpose (docs/ros_interface.md,
 "Pose and time control"), on two carts of the default scene (h = 10 ms, published at 20 Hz)."""
 import math
+import os
 import threading
 import time
 import unittest
 
+import rosbag
 import rospy
 import rostest
 from geometry_msgs.msg import PoseWithCovarianceStamped
@@ -147,6 +149,30 @@ class PoseAndStep(unittest.TestCase):
         self.send_initial_pose("map", 40.0, 40.0, 0.0)  # not cart_sim's frame: refused
         after, _ = self.stepped_odom_after(5)
         self.assertAlmostEqual(after.pose.pose.position.x, -3.0, delta=2 * TELEPORT_TOLERANCE)
+
+    def test_5_the_bag_goes_on_across_teleports_and_step_runs_out_at_the_end(self):
+        bag_path = rospy.get_param("/stepped/cart_sim/bag_path")
+        answer = self.step(5000)  # more than the 30 s run has left
+        self.assertFalse(answer.success)
+        self.assertIn("ran out", answer.message)
+        self.assertLess(answer.steps_taken, 5000)
+        self.assertAlmostEqual(answer.time, 30.0, delta=1e-9)
+        deadline = time.monotonic() + 30.0
+        while not os.path.exists(bag_path) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        self.assertTrue(os.path.exists(bag_path), f"cart_sim left no bag at {bag_path}")
+        stem = bag_path[:-len(".bag")]
+        self.assertFalse(os.path.exists(stem + "_run2.bag"), "a teleport started a new run file")
+        with rosbag.Bag(bag_path) as bag:
+            odometry = [(m.header.stamp.to_sec(), m.pose.pose.position.x)
+                        for _, m, _ in bag.read_messages(topics=["/stepped/odom"])]
+        stamps = [stamp for stamp, _ in odometry]
+        self.assertGreater(len(stamps), 100)
+        self.assertTrue(all(b > a for a, b in zip(stamps, stamps[1:])), "odom stamps in the bag went back")
+        self.assertAlmostEqual(stamps[-1], 30.0, delta=1e-9)
+        self.assertTrue(any(abs(x - 5.0) < TELEPORT_TOLERANCE for _, x in odometry))   # ~set_state's pose
+        self.assertTrue(any(abs(x + 3.0) < TELEPORT_TOLERANCE for _, x in odometry))   # /initialpose's pose
+        os.remove(bag_path)
 
 
 if __name__ == "__main__":
