@@ -111,21 +111,9 @@ void Simulation::advance_to(double time) {
 }
 
 void Simulation::reset() {
-  if (restarted_) {  // undo restart_from(): the loaded scene's state, schedule and reference
-    scene_.initial_state = loaded_initial_state_;
-    schedule_ = plan_steps(scene_.initial_state.time, scene_.duration, scene_.integrator.step_size);
-    reference_ = make_reference_solution(scene_, model_, effects_);
-    restarted_ = false;
-    initial_energy_ = model_.energy(scene_.initial_state);
-    initial_steering_momentum_ = model_.steering_momentum(scene_.initial_state);
-  }
-  stepper_ = make_cart_stepper(integrator_settings(scene_), model_, effects_);  // forgets adaptive step-size guesses
-  state_ = scene_.initial_state;
-  steps_taken_ = 0;
-  finished_off_grid_ = false;
-  statistics_ = StepStatistics{};
-  stepper_->prepare(state_, statistics_);
-  if (reference_) reference_->reset();
+  Scene loaded = scene_;
+  loaded.initial_state = loaded_initial_state_;  // also after restart_from(): the loaded scene's start
+  start_run(std::move(loaded));
   if (effects_.steering_command()) effects_.steering_command()->value = initial_command(scene_, "steering_torque");
   if (effects_.drive_command()) effects_.drive_command()->value = initial_command(scene_, "drive_torque");
 }
@@ -145,22 +133,28 @@ void Simulation::restart_from(const CartState& initial_state) {
       throw std::invalid_argument(message.str());
     }
   }
-  // Everything that can refuse is built before anything changes.
-  Scene restarted = scene_;
-  restarted.initial_state = initial_state;
-  StepSchedule schedule = plan_steps(initial_state.time, scene_.duration, scene_.integrator.step_size);
   try {
     check_singular_steering(model_, initial_state, scene_.integrator.step_size);
   } catch (const StepError& error) {
     throw std::invalid_argument(std::string("restart state: ") + error.what());
   }
-  std::unique_ptr<ReferenceSolution> reference = make_reference_solution(restarted, model_, effects_);
-  std::unique_ptr<CartStepper> stepper = make_cart_stepper(integrator_settings(restarted), model_, effects_);
+  Scene restarted = scene_;
+  restarted.initial_state = initial_state;
+  start_run(std::move(restarted));
+}
+
+void Simulation::start_run(Scene run_scene) {
+  // Everything that can refuse is built before anything changes.
+  const CartState& start = run_scene.initial_state;
+  StepSchedule schedule = plan_steps(start.time, run_scene.duration, run_scene.integrator.step_size);
+  std::unique_ptr<ReferenceSolution> reference = make_reference_solution(run_scene, model_, effects_);
+  // A new stepper forgets the step memory (adaptive step-size guesses, the stage predictor).
+  std::unique_ptr<CartStepper> stepper = make_cart_stepper(integrator_settings(run_scene), model_, effects_);
   StepStatistics statistics;
-  CartState state = initial_state;
-  stepper->prepare(state, statistics);  // the reversible control's pilots may refuse the new state
+  CartState state = start;
+  stepper->prepare(state, statistics);  // the reversible control's pilots may refuse the state
   // Commit: nothing below throws.
-  scene_ = std::move(restarted);
+  scene_ = std::move(run_scene);
   schedule_ = schedule;
   reference_ = std::move(reference);
   stepper_ = std::move(stepper);
@@ -170,7 +164,6 @@ void Simulation::restart_from(const CartState& initial_state) {
   finished_off_grid_ = false;
   initial_energy_ = model_.energy(state_);
   initial_steering_momentum_ = model_.steering_momentum(state_);
-  restarted_ = true;
 }
 
 bool Simulation::accepts_steering_command() const { return static_cast<bool>(effects_.steering_command()); }

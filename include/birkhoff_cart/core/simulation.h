@@ -96,10 +96,13 @@ class Simulation {
   StepSchedule schedule_;
   CartState loaded_initial_state_;  ///< the loaded scene's initial state, for reset()
   void take_step(double step_size, double next_time);
+  /// Builds the schedule, reference and stepper of a run of `run_scene` from its initial state and
+  /// commits them with zeroed counters and the invariants' initial values (reset(), restart_from()).
+  /// Throws, with nothing changed, when the reference or the reversible control refuses the state.
+  void start_run(Scene run_scene);
 
   std::uint64_t steps_taken_ = 0;
   bool finished_off_grid_ = false;  ///< step_to() left the grid t₀ + n h
-  bool restarted_ = false;          ///< restart_from() replaced the loaded initial state
   StepStatistics statistics_;
   double initial_energy_ = 0.0;
   double initial_steering_momentum_ = 0.0;
