@@ -140,6 +140,9 @@ void Simulation::restart_from(const CartState& initial_state) {
   }
   Scene restarted = scene_;
   restarted.initial_state = initial_state;
+  // The balances' integrals run from the run's start (docs eq. (3.7), (3.8)): a restart is one.
+  restarted.initial_state.applied_work = 0.0;
+  restarted.initial_state.steering_impulse = 0.0;
   start_run(std::move(restarted));
 }
 

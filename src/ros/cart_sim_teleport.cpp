@@ -12,8 +12,10 @@ namespace {
 
 /// The hinge B of a cart whose base_link (rear-axle midpoint A) is at (x, y) with heading θ:
 /// B = A + l (cos θ, sin θ), the inverse of CartModel::rear_axle_midpoint (docs/model.md).
+/// The heading is a new value: its compensated-summation low part (state.h) starts at 0.
 void place_hinge(CartState& state, double base_x, double base_y, double heading, double wheelbase) {
   state.heading = heading;
+  state.heading_low = 0.0;
   state.x = base_x + wheelbase * std::cos(heading);  // [m]
   state.y = base_y + wheelbase * std::sin(heading);  // [m]
 }
@@ -66,6 +68,7 @@ bool CartSimNode::on_set_state(SetCartState::Request& request, SetCartState::Res
   CartState target = simulation_->state();  // keeps the time, the wheel spin angles and the arc length
   place_hinge(target, request.x, request.y, request.heading, simulation_->model().parameters().wheelbase);
   target.steering_angle = request.steering_angle;
+  target.steering_angle_low = 0.0;
   target.forward_speed = request.forward_speed;
   target.steering_rate = request.steering_rate;
   response.success = teleport(target, "~set_state", response.message);

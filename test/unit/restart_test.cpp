@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <string>
@@ -17,6 +18,8 @@ namespace {
 Scene load(const std::string& name) {
   return load_scene(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/" + name + ".yaml");
 }
+
+constexpr double kBalanceTolerance = 5e-5;  // energy [J] and p2 [N·m·s] balance residuals after 0.5 s driven (as simulation_test)
 
 bool bit_identical(const CartState& a, const CartState& b) { return std::memcmp(&a, &b, sizeof(CartState)) == 0; }
 
@@ -78,6 +81,31 @@ TEST(Restart, ResetAfterARestartReturnsToTheLoadedScene) {
   for (int k = 0; k < 300; ++k) simulation.step();
   EXPECT_TRUE(bit_identical(simulation.state(), loaded.state()));
   EXPECT_EQ(simulation.diagnostics().energy_balance_residual, loaded.diagnostics().energy_balance_residual);
+}
+
+TEST(Restart, ATeleportFromTheCurrentStateStartsTheBalancesAgain) {
+  // The node teleports by editing a copy of the current state, which carries the run's work and
+  // impulse integrals (W = ∫ω·Q dt, I2 = ∫Q2 dt): the restarted run's balances start from zero.
+  Scene scene = load("driven");
+  Simulation simulation(scene);
+  simulation.set_drive_command(40.0);
+  simulation.set_steering_command(1.0);
+  for (int k = 0; k < 500; ++k) simulation.step();
+  ASSERT_GT(std::abs(simulation.state().applied_work), 1.0);  // [J]: the drive has done work
+  CartState target = simulation.state();
+  target.x += 3.0;
+  target.forward_speed = 0.5;
+  simulation.restart_from(target);
+  EXPECT_EQ(simulation.state().applied_work, 0.0);
+  EXPECT_EQ(simulation.state().steering_impulse, 0.0);
+  EXPECT_EQ(simulation.diagnostics().energy_balance_residual, 0.0);
+  EXPECT_EQ(simulation.diagnostics().p2_balance_residual, 0.0);
+  for (int k = 0; k < 500; ++k) simulation.step();
+  const Diagnostics diagnostics = simulation.diagnostics();
+  std::printf("driven, 0.5 s after a teleport from the current state: energy balance %.3e J, p2 balance %.3e N m s\n",
+              diagnostics.energy_balance_residual, diagnostics.p2_balance_residual);
+  EXPECT_LT(std::abs(diagnostics.energy_balance_residual), kBalanceTolerance);
+  EXPECT_LT(std::abs(diagnostics.p2_balance_residual), kBalanceTolerance);
 }
 
 /// Expects restart_from(`target`) to throw std::invalid_argument naming `expected`, and the run to

@@ -66,7 +66,8 @@ class Simulation {
   void reset();
   /// A new run from `initial_state` at its own time t₀' (a teleport: the caller passes the current
   /// time to keep time continuous). Restarts like reset(): the step memory, the counters, the
-  /// reference (rebuilt from the new state) and the invariants' initial values; the schedule is
+  /// reference (rebuilt from the new state), the invariants' initial values and the balances'
+  /// integrals (applied_work, steering_impulse start at 0); the schedule is
   /// t₀' + the scene's duration; commands keep their values. Refuses, leaving everything as it was,
   /// with std::invalid_argument naming the problem: a non-finite field, a state where the next step
   /// would meet a singular steering angle (the paper's special case at χ = kπ, docs/hard_cases.md §1),
