@@ -8,7 +8,9 @@
 //
 // Columns: t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,local_error_estimate (SI
 // units; energy is T* [J], p2 the front axle's yaw momentum [kg·m²/s], local_error_estimate the
-// last step's ê [-], empty when the integrator has none: docs/accuracy.md); one row per output
+// last step's ê [-], empty when the integrator has none: docs/accuracy.md), and with the scene's
+// odometry sensor on, odom_x,odom_y,odom_theta,odom_sigma_position,odom_sigma_theta (its estimate of
+// A and θ, read at every row, and their standard deviations: docs/odometry_sensor.md); one row per output
 // instant t0 + k/HZ from the start to the end, both included; values printed with %.17g
 // (round-trip exact). At the end a summary goes to stdout, with the accuracy guard's verdict
 // (the scene's `accuracy` limits, checked at every row). The run is cut
@@ -41,6 +43,7 @@
 #include "birkhoff_cart/core/run_summary.h"
 #include "birkhoff_cart/core/random_scene.h"
 #include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/sensors/odometry_sensor.h"
 #include "birkhoff_cart/core/simulation.h"
 #include "birkhoff_cart/core/step_schedule.h"
 #include "birkhoff_cart/core/version.h"
@@ -216,7 +219,8 @@ std::string key_with_option(const std::string& key) {
 }
 
 /// One CSV row at `time`, and the accuracy guard's check of the state there.
-void write_row(std::FILE* file, double time, const Simulation& simulation, birkhoff_cart::AccuracyGuard& guard) {
+void write_row(std::FILE* file, double time, const Simulation& simulation, birkhoff_cart::AccuracyGuard& guard,
+               birkhoff_cart::OdometrySensor* sensor) {
   const CartState& state = simulation.state();
   const birkhoff_cart::CartModel& model = simulation.model();
   std::fprintf(file, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,", time,
@@ -227,6 +231,12 @@ void write_row(std::FILE* file, double time, const Simulation& simulation, birkh
   const double estimate = statistics.local_error_estimate_last_step;  // ê [-]; none before the first step
   if (birkhoff_cart::has_local_error_estimate(statistics) && std::isfinite(estimate)) {
     std::fprintf(file, "%.17g", estimate);
+  }
+  if (sensor) {  // the odometry sensor's estimate of A and its standard deviations (docs/odometry_sensor.md)
+    const birkhoff_cart::OdometryEstimate& odometry = sensor->read(state);
+    std::fprintf(file, ",%.17g,%.17g,%.17g,%.17g,%.17g", odometry.x, odometry.y, odometry.heading,
+                 std::sqrt(odometry.pose_covariance(0, 0) + odometry.pose_covariance(1, 1)),
+                 std::sqrt(odometry.pose_covariance(2, 2)));
   }
   std::fprintf(file, "\n");
   guard.check(time, simulation.diagnostics(), statistics);
@@ -310,14 +320,20 @@ int run(int argc, char** argv) {
     std::fprintf(stderr, "cart_simulate: cannot write '%s': %s\n", output_path.c_str(), std::strerror(errno));
     return kExitSettings;
   }
-  std::fprintf(file, "t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,local_error_estimate\n");
+  std::optional<birkhoff_cart::OdometrySensor> sensor;
+  if (scene.odometry_sensor) {
+    sensor.emplace(*scene.odometry_sensor, simulation->model());
+    sensor->start(simulation->state(), true);
+  }
+  std::fprintf(file, "t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,local_error_estimate%s\n",
+               sensor ? ",odom_x,odom_y,odom_theta,odom_sigma_position,odom_sigma_theta" : "");
   const birkhoff_cart::StepSchedule& schedule = simulation->schedule();
   const double start_time = schedule.start_time;  // t0 [s]
   birkhoff_cart::AccuracyGuard guard(scene.accuracy);
   ProgressReport progress(!arguments.count("--quiet"), start_time, schedule.end_time);
   std::uint64_t rows = 0;
   const auto write_state = [&](double time) {
-    write_row(file, time, *simulation, guard);
+    write_row(file, time, *simulation, guard, sensor ? &*sensor : nullptr);
     if (std::ferror(file)) throw OutputError(std::string("writing the CSV failed: ") + std::strerror(errno));
     ++rows;
   };
@@ -354,6 +370,7 @@ int run(int argc, char** argv) {
     return kExitSettings;
   }
   std::printf("cart_simulate %s", birkhoff_cart::run_summary(*simulation, guard).c_str());
+  if (sensor) std::printf("%s\n", birkhoff_cart::odometry_drift_line(*sensor, simulation->state(), simulation->model()).c_str());
   if (guard.level() == birkhoff_cart::AccuracyLevel::kError) {
     const bool warn_only = arguments.count("--on-accuracy-error") && arguments.at("--on-accuracy-error") == "warn";
     std::fprintf(stderr, "cart_simulate: accuracy %s%s\n", guard.summary().c_str(),

@@ -176,7 +176,7 @@ Scene read_scene(const SceneReader& reader, const YAML::Node& root, const std::s
   if (!root || root.IsNull()) reader.fail("(document)", "is empty");
   reader.require_map(root, "",
                      {"description", "cart", "paper_special_case", "initial_state", "duration", "integrator",
-                      "output_rate", "effects", "reference", "accuracy"});
+                      "output_rate", "effects", "reference", "accuracy", "odometry_sensor"});
   Scene scene;
   scene.name = file_stem(path);
   scene.source_path = path;
@@ -201,6 +201,7 @@ Scene read_scene(const SceneReader& reader, const YAML::Node& root, const std::s
   scene.effects = scene_detail::read_effects(reader, root["effects"]);
   scene.reference = read_reference(reader, root["reference"], scene.paper_special_case);
   scene.accuracy = scene_detail::read_accuracy(reader, root["accuracy"]);
+  scene.odometry_sensor = scene_detail::read_odometry_sensor(reader, root["odometry_sensor"]);
 
   // The cart must give a usable mass matrix (only the declared paper case may be singular).
   if (scene.paper_special_case && scene.cart.wheelbase != 1.0) {

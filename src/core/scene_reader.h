@@ -4,6 +4,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -60,6 +61,9 @@ std::string join_names(const std::vector<std::string>& names);
 
 /// Reads the `effects` map (enabled effects only, in file order).
 std::vector<EffectSpec> read_effects(const SceneReader& reader, const YAML::Node& effects);
+
+/// Reads the optional `odometry_sensor` map: absent, the sensor is off.
+std::optional<OdometrySensorSettings> read_odometry_sensor(const SceneReader& reader, const YAML::Node& node);
 
 /// Reads the optional `accuracy` map over the defaults of AccuracyRequirements.
 AccuracyRequirements read_accuracy(const SceneReader& reader, const YAML::Node& accuracy);

@@ -47,6 +47,7 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   } catch (const std::exception& error) {
     throw NodeStartupError("cannot build the simulation of " + parameters_.scene_path + ": " + error.what());
   }
+  if (scene.odometry_sensor) odometry_sensor_.emplace(*scene.odometry_sensor, simulation_->model());
   try {
     accuracy_guard_ = AccuracyGuard(ros_accuracy::load_requirements(private_node_, scene.accuracy));
   } catch (const std::exception& error) {
@@ -151,6 +152,7 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   node_.setCallbackQueue(&callback_queue_);
   private_node_.setCallbackQueue(&callback_queue_);
   odometry_publisher_ = node_.advertise<nav_msgs::Odometry>("odom", 50);
+  ground_truth_publisher_ = node_.advertise<nav_msgs::Odometry>("ground_truth", 50);
   joint_state_publisher_ = node_.advertise<sensor_msgs::JointState>("joint_states", 50);
   integration_error_publisher_ = private_node_.advertise<IntegrationError>("integration_error", 50);
   // /clock through a NodeHandle whose own remapping keeps it /clock: main() remaps roscpp's internal
@@ -167,6 +169,15 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   // sendTransform() builds a new TFMessage (a vector) at every call; same topic and queue.
   if (parameters_.publish_tf) transform_publisher_ = ros::NodeHandle().advertise<tf2_msgs::TFMessage>(kTransformTopic, 100);
   odometry_topic_ = odometry_publisher_.getTopic();
+  ground_truth_topic_ = ground_truth_publisher_.getTopic();
+  // REP-105: the world frame (map) is the ground truth's; the odometry starts at the true pose, so
+  // world → odom is the identity, latched on /tf_static once (docs/odometry_sensor.md, "Frames").
+  world_transform_.transforms.push_back(
+      ros_conversions::world_to_odom_transform(parameters_.frames, simulation_->scene().initial_state.time));
+  if (parameters_.publish_tf && parameters_.publish_world_tf) {
+    static_transform_publisher_ = ros::NodeHandle().advertise<tf2_msgs::TFMessage>("/tf_static", 10, true);
+    static_transform_publisher_.publish(world_transform_);
+  }
   joint_state_topic_ = joint_state_publisher_.getTopic();
   integration_error_topic_ = integration_error_publisher_.getTopic();
   instant_messages_.emplace(parameters_.frames, parameters_.odometry_covariance);
@@ -233,6 +244,8 @@ void CartSimNode::restart_schedule() {
   if (std::isfinite(end_time_)) {
     schedule_ = plan_steps(start_time, whole_run ? run_duration_ : end_time_ - start_time, simulation_->step_size());
   }
+  // The odometry starts again at the true pose; after ~reset its noise runs again from the seed.
+  if (odometry_sensor_) odometry_sensor_->start(simulation_->state(), whole_run);
   next_publish_index_ = 1;
   next_diagnostic_index_ = 1;
   clock_started_ = false;

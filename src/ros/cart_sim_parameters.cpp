@@ -62,7 +62,7 @@ const std::vector<std::string>& cart_sim_parameter_names() {
       "scene", "integrator", "step_size", "publish_rate", "fast", "real_time_factor", "duration", "command_timeout",
       "max_steering_torque", "max_drive_torque", "lockstep", "lockstep_topics", "lockstep_timeout", "bag_path",
       "record_wall_time", "bag_compression", "min_free_disk_space", "summary_path", "frame_prefix", "odom_frame",
-      "base_frame", "pose_covariance_diagonal", "twist_covariance_diagonal", "publish_tf", "publish_clock",
+      "base_frame", "world_frame", "publish_world_tf", "pose_covariance_diagonal", "twist_covariance_diagonal", "publish_tf", "publish_clock",
       "follow_clock", "start_paused", "diagnostic_period", "energy_residual_warn", "energy_residual_error",
       "p2_residual_warn", "p2_residual_error", "constraint_residual_warn", "constraint_residual_error", "end_launch",
       "accuracy/"};
@@ -121,6 +121,11 @@ CartSimParameters load_parameters(const ros::NodeHandle& private_node) {
       parameters.frame_prefix, read_parameter<std::string>(p, "odom_frame", parameters.frames.odom),
       read_parameter<std::string>(p, "base_frame", parameters.frames.base_link));
   require(parameters.frames.odom != parameters.frames.base_link, "~odom_frame and ~base_frame must differ");
+  parameters.frames.world = read_parameter<std::string>(p, "world_frame", parameters.frames.world);
+  require(!parameters.frames.world.empty() && parameters.frames.world != parameters.frames.odom &&
+              parameters.frames.world != parameters.frames.base_link,
+          "~world_frame must be a frame name other than the odom and base frames");
+  parameters.publish_world_tf = read_parameter<bool>(p, "publish_world_tf", parameters.publish_world_tf);
   parameters.odometry_covariance.pose_diagonal =
       read_variances(p, "pose_covariance_diagonal", parameters.odometry_covariance.pose_diagonal);
   parameters.odometry_covariance.twist_diagonal =

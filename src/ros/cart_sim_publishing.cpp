@@ -23,8 +23,10 @@ void CartSimNode::publish_instant() {
   period_stepping_wall_time_ = 0.0;
   period_steps_ = 0;
   InstantMessages& messages = *instant_messages_;
-  messages.fill(*simulation_, accuracy_guard_, last_wall_time_per_step_);
+  const OdometryEstimate* estimate = odometry_sensor_ ? &odometry_sensor_->read(simulation_->state()) : nullptr;
+  messages.fill(*simulation_, accuracy_guard_, last_wall_time_per_step_, estimate);
 
+  ground_truth_publisher_.publish(messages.ground_truth);
   odometry_publisher_.publish(messages.odometry);
   joint_state_publisher_.publish(messages.joints);
   integration_error_publisher_.publish(messages.integration_error);
@@ -41,6 +43,12 @@ void CartSimNode::publish_instant() {
     if (!parameters_.record_wall_time) error.wall_time_per_step = 0.0;  // the one field that differs between runs
     try {
       recorder_->write(integration_error_topic_, error.header.stamp, error);
+      if (!world_transform_recorded_) {  // once per bag, so that a replay has the world frame
+        recorder_->write("/tf_static", stamp, world_transform_);
+        world_transform_recorded_ = true;
+      }
+      // Without a sensor ground_truth equals odom (pose and twist): the bag keeps odom only.
+      if (odometry_sensor_) recorder_->write(ground_truth_topic_, stamp, messages.ground_truth);
       recorder_->write(odometry_topic_, stamp, messages.odometry);
       recorder_->write(joint_state_topic_, messages.joints.header.stamp, messages.joints);
       if (transform_sent) recorder_->write(kTransformTopic, stamp, messages.transforms);

@@ -90,6 +90,7 @@ bool CartSimNode::on_reset(std_srvs::Empty::Request& /*request*/, std_srvs::Empt
 
 void CartSimNode::open_record(const std::string& path) {
   ++run_index_;
+  world_transform_recorded_ = false;
   recorder_ = std::make_unique<BagRecorder>(run_bag_path(path, run_index_),
                                             BagRecorder::parse_compression(parameters_.bag_compression),
                                             parameters_.min_free_disk_space);

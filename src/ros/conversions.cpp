@@ -80,6 +80,59 @@ void fill_odometry(nav_msgs::Odometry& odometry, const CartState& state, const C
   set_diagonal(odometry.twist.covariance, covariance.twist_diagonal);
 }
 
+void fill_odometry(nav_msgs::Odometry& odometry, const OdometryEstimate& estimate, const FrameNames& frames,
+                   const OdometryCovariance& planar) {
+  odometry.header.stamp = to_ros_time(estimate.time);
+  odometry.header.frame_id = frames.odom;
+  odometry.child_frame_id = frames.base_link;
+  odometry.pose.pose.position.x = estimate.x;
+  odometry.pose.pose.position.y = estimate.y;
+  odometry.pose.pose.position.z = 0.0;
+  set_yaw_quaternion(odometry.pose.pose.orientation, estimate.heading);
+  // (x, y, yaw) from the sensor's propagated covariance (docs/odometry_sensor.md eq. (O6)); z, roll,
+  // pitch keep the planar model's configured variances. Row-major 6×6, order x y z roll pitch yaw.
+  set_diagonal(odometry.pose.covariance, planar.pose_diagonal);
+  constexpr int kPoseIndex[3] = {0, 1, 5};
+  for (int row = 0; row < 3; ++row) {
+    for (int column = 0; column < 3; ++column) {
+      odometry.pose.covariance[kPoseIndex[row] * 6 + kPoseIndex[column]] = estimate.pose_covariance(row, column);
+    }
+  }
+  odometry.twist.twist.linear.x = estimate.speed;  // v̂_A [m/s]
+  odometry.twist.twist.linear.y = 0.0;
+  odometry.twist.twist.linear.z = 0.0;
+  odometry.twist.twist.angular.x = 0.0;
+  odometry.twist.twist.angular.y = 0.0;
+  odometry.twist.twist.angular.z = estimate.heading_rate;  // [rad/s]
+  set_diagonal(odometry.twist.covariance, planar.twist_diagonal);  // linear.y: A has no lateral speed
+  constexpr int kTwistIndex[2] = {0, 5};
+  for (int row = 0; row < 2; ++row) {
+    for (int column = 0; column < 2; ++column) {
+      odometry.twist.covariance[kTwistIndex[row] * 6 + kTwistIndex[column]] = estimate.twist_covariance(row, column);
+    }
+  }
+}
+
+void fill_transform(geometry_msgs::TransformStamped& transform, const OdometryEstimate& estimate,
+                    const FrameNames& frames) {
+  transform.header.stamp = to_ros_time(estimate.time);
+  transform.header.frame_id = frames.odom;
+  transform.child_frame_id = frames.base_link;
+  transform.transform.translation.x = estimate.x;
+  transform.transform.translation.y = estimate.y;
+  transform.transform.translation.z = 0.0;
+  set_yaw_quaternion(transform.transform.rotation, estimate.heading);
+}
+
+geometry_msgs::TransformStamped world_to_odom_transform(const FrameNames& frames, double time) {
+  geometry_msgs::TransformStamped transform;
+  transform.header.stamp = to_ros_time(time);
+  transform.header.frame_id = frames.world;
+  transform.child_frame_id = frames.odom;
+  transform.transform.rotation.w = 1.0;
+  return transform;
+}
+
 nav_msgs::Odometry to_odometry(const CartState& state, const CartModel& model, const FrameNames& frames,
                                const OdometryCovariance& covariance) {
   nav_msgs::Odometry odometry;

@@ -7,16 +7,27 @@ namespace birkhoff_cart {
 
 InstantMessages::InstantMessages(ros_conversions::FrameNames frames, ros_conversions::OdometryCovariance covariance)
     : frames_(std::move(frames)), covariance_(covariance) {
+  ground_truth_frames_ = frames_;
+  ground_truth_frames_.odom = frames_.world;
   transforms.transforms.resize(1);
 }
 
-void InstantMessages::fill(const Simulation& simulation, AccuracyGuard& guard, double wall_time_per_step) {
+void InstantMessages::fill(const Simulation& simulation, AccuracyGuard& guard, double wall_time_per_step,
+                           const OdometryEstimate* estimate) {
   const CartState& state = simulation.state();
   const CartModel& model = simulation.model();
-  ros_conversions::fill_odometry(odometry, state, model, frames_, covariance_);
+  ros_conversions::fill_odometry(ground_truth, state, model, ground_truth_frames_, ros_conversions::OdometryCovariance{});
+  ground_truth.pose.covariance.fill(0.0);  // exact
+  ground_truth.twist.covariance.fill(0.0);
+  if (estimate) {
+    ros_conversions::fill_odometry(odometry, *estimate, frames_, covariance_);
+    ros_conversions::fill_transform(transforms.transforms.front(), *estimate, frames_);
+  } else {
+    ros_conversions::fill_odometry(odometry, state, model, frames_, covariance_);
+    ros_conversions::fill_transform(transforms.transforms.front(), state, model, frames_);
+  }
   ros_conversions::fill_joint_state(joints, state, model, ros_conversions::actuator_efforts(simulation),
                                     frames_.joint_prefix);
-  ros_conversions::fill_transform(transforms.transforms.front(), state, model, frames_);
   const Diagnostics diagnostics = simulation.diagnostics();
   guard.check(state.time, diagnostics, simulation.statistics());
   ros_conversions::fill_integration_error(integration_error, state, diagnostics, simulation.statistics(),

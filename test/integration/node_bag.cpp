@@ -70,7 +70,9 @@ TEST(NodeBag, RecordHasTopicsCountsAndCompression) {
   EXPECT_EQ(counts["/joint_states"], expected);
   EXPECT_EQ(counts["/tf"], expected) << "odom -> base_link, so a replay in rviz places the cart";
   EXPECT_EQ(counts["/steering_torque"], 3);
-  EXPECT_EQ(counts.size(), 5u);
+  EXPECT_EQ(counts["/tf_static"], 1) << "map -> odom, once per bag";
+  EXPECT_EQ(counts.count("/ground_truth"), 0u) << "without an odometry sensor odom is the ground truth";
+  EXPECT_EQ(counts.size(), 6u);
 
   // Integration errors are stamped with scene time and carry the run's settings.
   rosbag::Bag bag(bag_path, rosbag::bagmode::Read);

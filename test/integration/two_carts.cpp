@@ -133,8 +133,11 @@ TEST(TwoCarts, EachCartHasItsOwnTreeAndOdometryUnderOneClock) {
 
   check_cart(cart1, cart1_scene, buffer);
   check_cart(cart2, cart2_scene, buffer);
-  // Two trees, no shared frame.
-  EXPECT_FALSE(buffer.canTransform("cart1/odom", "cart2/odom", ros::Time(0)));
+  // Two trees joined only at the shared world frame `map` (each cart_sim: the identity map → cartN/odom).
+  ASSERT_TRUE(buffer.canTransform("cart1/odom", "cart2/odom", ros::Time(0)));
+  const geometry_msgs::TransformStamped between = buffer.lookupTransform("cart1/odom", "cart2/odom", ros::Time(0));
+  EXPECT_EQ(between.transform.translation.x, 0.0);
+  EXPECT_EQ(between.transform.rotation.w, 1.0);
   EXPECT_FALSE(buffer._frameExists("odom")) << "an unprefixed frame leaked";
   EXPECT_FALSE(buffer._frameExists("base_link")) << "an unprefixed frame leaked";
   // The carts really moved apart from rest.

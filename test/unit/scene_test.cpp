@@ -105,6 +105,9 @@ INSTANTIATE_TEST_SUITE_P(
         SceneRow{"stiff_hinge", 0.3, 3.0, 0.0, 4.0, {"steering_stiffness", "steering_damping"}},
         SceneRow{"default", 0.0, 1.0, 0.0, 60.0,
                  {"drive_torque", "rolling_resistance", "air_drag", "steering_torque", "steering_damping"},
+                 "birkhoff_gauss4", 1e-2},
+        SceneRow{"noisy_odometry", 0.0, 1.0, 0.0, 60.0,
+                 {"drive_torque", "rolling_resistance", "air_drag", "steering_torque", "steering_damping"},
                  "birkhoff_gauss4", 1e-2}),
     [](const ::testing::TestParamInfo<SceneRow>& info) { return info.param.name; });
 
@@ -143,6 +146,15 @@ TEST(ShippedScenes, EffectParametersMatchTheTable) {
   EXPECT_EQ(slalom.reference.shadow.name, "dopri5");
   EXPECT_EQ(slalom.reference.shadow.tolerance, 1e-12);
   EXPECT_EQ(load_scene(scene_path("free_coast")).reference.kind, ReferenceSettings::Kind::kNone);
+  EXPECT_FALSE(slalom.odometry_sensor.has_value());  // odom is the exact state unless a scene says otherwise
+
+  const Scene noisy = load_scene(scene_path("noisy_odometry"));  // the table's sensor settings
+  ASSERT_TRUE(noisy.odometry_sensor.has_value());
+  EXPECT_EQ(noisy.odometry_sensor->heading_source, HeadingSource::kGyro);
+  EXPECT_EQ(noisy.odometry_sensor->wheel_encoder_counts, 2048u);
+  EXPECT_EQ(noisy.odometry_sensor->wheel_distance_noise, 0.002);
+  EXPECT_EQ(noisy.odometry_sensor->gyro_noise_density, 5.0e-4);
+  EXPECT_EQ(noisy.odometry_sensor->seed, 7u);
 }
 
 TEST(ShippedScenes, EveryFileInTheSceneDirectoryLoads) {

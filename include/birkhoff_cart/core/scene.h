@@ -5,6 +5,7 @@
 
 #include <stdexcept>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "birkhoff_cart/core/effect_spec.h"
 #include "birkhoff_cart/core/integrator_settings.h"
 #include "birkhoff_cart/core/parameters.h"
+#include "birkhoff_cart/core/sensors/odometry_sensor.h"
 #include "birkhoff_cart/core/state.h"
 
 namespace birkhoff_cart {
@@ -48,6 +50,9 @@ struct Scene {
   std::vector<EffectSpec> effects;     ///< only the enabled ones
   ReferenceSettings reference;
   AccuracyRequirements accuracy;       ///< the `accuracy` section (defaults: docs/accuracy.md §2)
+  /// The `odometry_sensor` section: odometry from simulated encoders (docs/odometry_sensor.md);
+  /// none = odometry is the exact state.
+  std::optional<OdometrySensorSettings> odometry_sensor;
 };
 
 /// Loads and validates a scene. Throws SceneError naming the file and the key.

@@ -38,10 +38,12 @@
 #include <std_srvs/Empty.h>
 #include <std_srvs/SetBool.h>
 #include <rosgraph_msgs/Clock.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include "birkhoff_cart/core/accuracy_guard.h"
 #include "birkhoff_cart/SetCartState.h"
 #include "birkhoff_cart/StepRun.h"
+#include "birkhoff_cart/core/sensors/odometry_sensor.h"
 #include "birkhoff_cart/core/simulation.h"
 #include "birkhoff_cart/ros/bag_recorder.h"
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
@@ -166,12 +168,19 @@ class CartSimNode {
   std::uint64_t run_index_ = 0;  ///< runs recorded so far (a reset starts the next run's bag)
 
   ros::Publisher odometry_publisher_;
+  ros::Publisher ground_truth_publisher_;
+  ros::Publisher static_transform_publisher_;  ///< /tf_static, latched: the identity world → odom
   ros::Publisher joint_state_publisher_;
   ros::Publisher integration_error_publisher_;
   ros::Publisher clock_publisher_;
   ros::Publisher transform_publisher_;  ///< /tf (tf2_msgs/TFMessage), as tf2_ros::TransformBroadcaster advertises it
   /// The topics as recorded in the bag (resolved names, kept: Publisher::getTopic() returns a copy).
   std::string odometry_topic_;
+  std::string ground_truth_topic_;
+  tf2_msgs::TFMessage world_transform_;  ///< world → odom, published once and recorded into each bag
+  bool world_transform_recorded_ = false;  ///< into the current bag
+  /// The scene's odometry sensor (docs/odometry_sensor.md); none: odom is the exact state.
+  std::optional<OdometrySensor> odometry_sensor_;
   std::string joint_state_topic_;
   std::string integration_error_topic_;
   static constexpr const char* kTransformTopic = "/tf";

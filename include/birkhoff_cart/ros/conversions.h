@@ -12,6 +12,7 @@
 #include <sensor_msgs/JointState.h>
 
 #include "birkhoff_cart/IntegrationError.h"
+#include "birkhoff_cart/core/sensors/odometry_sensor.h"
 #include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/diagnostics.h"
 #include "birkhoff_cart/core/simulation.h"
@@ -29,6 +30,9 @@ struct FrameNames {
   std::string odom = "odom";            ///< fixed frame
   std::string base_link = "base_link";  ///< rear-axle midpoint A on the ground
   std::string joint_prefix;             ///< before every joint name in joint_states ("" = the URDF's)
+  /// The world frame of the ground truth (REP-105 map; not prefixed: carts share the world). The
+  /// odometry starts at the true pose, so world → odom is the identity (docs/odometry_sensor.md).
+  std::string world = "map";
 };
 
 /// `prefix` + odom, `prefix` + base_link, and `prefix` as the joint prefix.
@@ -75,6 +79,20 @@ geometry_msgs::TransformStamped to_transform(const CartState& state, const CartM
 /// to_transform into an existing message (no allocation once filled).
 void fill_transform(geometry_msgs::TransformStamped& transform, const CartState& state, const CartModel& model,
                     const FrameNames& frames);
+
+/// nav_msgs/Odometry of the odometry sensor's dead-reckoned estimate (base_link in odom): the
+/// (x, y, yaw) block of the pose covariance and the (v, yaw rate) block of the twist covariance are the
+/// sensor's (docs/odometry_sensor.md eqs. (O6)–(O7)), the other entries `planar`'s diagonals. Filled
+/// in place (no allocation once it has held the frame names).
+void fill_odometry(nav_msgs::Odometry& odometry, const OdometryEstimate& estimate, const FrameNames& frames,
+                   const OdometryCovariance& planar);
+
+/// odom → base_link of the sensor's estimate (same pose as its odometry).
+void fill_transform(geometry_msgs::TransformStamped& transform, const OdometryEstimate& estimate,
+                    const FrameNames& frames);
+
+/// The identity world → odom at `time` [s] (published on /tf_static).
+geometry_msgs::TransformStamped world_to_odom_transform(const FrameNames& frames, double time);
 
 /// Joint positions (χ, φ1..φ4) [rad], velocities (ω2, φ̇1..φ̇4) [rad/s] and actuator efforts
 /// (τ, T/2, T/2, 0, 0) [N·m]. Joint names are `joint_prefix` + joint_names().

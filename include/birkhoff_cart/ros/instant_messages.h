@@ -24,18 +24,23 @@ class InstantMessages {
  public:
   InstantMessages(ros_conversions::FrameNames frames, ros_conversions::OdometryCovariance covariance);
 
-  /// Fills odometry, joints, the odom → base_link transform and integration_error from the
-  /// simulation's current state; checks `guard` with its diagnostics (the accuracy fields of
-  /// integration_error follow it). `wall_time_per_step` [s] goes into integration_error.
-  void fill(const Simulation& simulation, AccuracyGuard& guard, double wall_time_per_step);
+  /// Fills ground_truth, odometry, joints, the odom → base_link transform and integration_error
+  /// from the simulation's current state; checks `guard` with its diagnostics (the accuracy fields of
+  /// integration_error follow it). `wall_time_per_step` [s] goes into integration_error. With an
+  /// odometry sensor's `estimate`, odometry and the transform are the estimate's; without, they are
+  /// the exact state, as ground_truth is.
+  void fill(const Simulation& simulation, AccuracyGuard& guard, double wall_time_per_step,
+            const OdometryEstimate* estimate = nullptr);
 
-  nav_msgs::Odometry odometry;
+  nav_msgs::Odometry ground_truth;  ///< the exact state: base_link in the world frame, covariances 0
+  nav_msgs::Odometry odometry;      ///< in odom: the exact state, or the odometry sensor's estimate
   sensor_msgs::JointState joints;
   tf2_msgs::TFMessage transforms;  ///< one transform: odom → base_link
   IntegrationError integration_error;
 
  private:
   ros_conversions::FrameNames frames_;
+  ros_conversions::FrameNames ground_truth_frames_;  ///< frames_ with the world frame as the fixed one
   ros_conversions::OdometryCovariance covariance_;
   /// The guard's event count when its status line was last written (it changes only with them).
   std::size_t accuracy_events_seen_ = std::numeric_limits<std::size_t>::max();
