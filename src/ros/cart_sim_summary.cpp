@@ -133,9 +133,7 @@ void CartSimNode::write_summary(const std::string& outcome) {
   if (!control.empty()) text << " Step size: the output step h; " << control << ".";
   if (parameters_.lockstep) text << " Lockstep timeouts: " << lockstep_timeouts_ << ".";
   if (odometry_sensor_ && odometry_sensor_->estimate().time == state.time) {  // read at the last instant
-    std::string line = odometry_drift_line(*odometry_sensor_, state, simulation_->model());
-    line[0] = 'O';
-    text << " " << line << ".";
+    text << " " << odometry_drift_line(*odometry_sensor_, state, simulation_->model()) << ".";
   }
   if (recorder_) {
     text << " Bag: " << recorder_->current_path() << (record_failure_ ? " (unfinished; " : " (");

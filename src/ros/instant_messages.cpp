@@ -4,6 +4,12 @@
 #include <utility>
 
 namespace birkhoff_cart {
+namespace {
+
+/// The ground truth's covariances: it is the exact state.
+const ros_conversions::OdometryCovariance kExactCovariance{{0, 0, 0, 0, 0, 0}, {0, 0, 0, 0, 0, 0}};
+
+}  // namespace
 
 InstantMessages::InstantMessages(ros_conversions::FrameNames frames, ros_conversions::OdometryCovariance covariance)
     : frames_(std::move(frames)), covariance_(covariance) {
@@ -16,9 +22,7 @@ void InstantMessages::fill(const Simulation& simulation, AccuracyGuard& guard, d
                            const OdometryEstimate* estimate) {
   const CartState& state = simulation.state();
   const CartModel& model = simulation.model();
-  ros_conversions::fill_odometry(ground_truth, state, model, ground_truth_frames_, ros_conversions::OdometryCovariance{});
-  ground_truth.pose.covariance.fill(0.0);  // exact
-  ground_truth.twist.covariance.fill(0.0);
+  ros_conversions::fill_odometry(ground_truth, state, model, ground_truth_frames_, kExactCovariance);
   if (estimate) {
     ros_conversions::fill_odometry(odometry, *estimate, frames_, covariance_);
     ros_conversions::fill_transform(transforms.transforms.front(), *estimate, frames_);

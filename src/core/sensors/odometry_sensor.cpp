@@ -241,7 +241,7 @@ std::string odometry_drift_line(const OdometrySensor& sensor, const CartState& t
   const double heading_error = estimate.heading - truth.heading;                                   // [rad]
   char line[400];
   std::snprintf(line, sizeof line,
-                "odometry sensor (heading from %s, seed %llu): after %.4g m rolled the estimate is %.3g m and %.3g "
+                "Odometry sensor (heading from %s, seed %llu): after %.4g m rolled the estimate is %.3g m and %.3g "
                 "rad off the truth; its covariance gives 1 sigma %.3g m and %.3g rad (random noise only; "
                 "docs/odometry_sensor.md)",
                 to_string(sensor.settings().heading_source), static_cast<unsigned long long>(sensor.settings().seed),

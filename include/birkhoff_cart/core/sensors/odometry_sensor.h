@@ -106,8 +106,8 @@ class OdometrySensor {
   OdometryEstimate estimate_;
 };
 
-/// One line for run summaries: how far the sensor's estimate is from `truth` (position of A [m],
-/// heading [rad]) against its covariance's standard deviations.
+/// One sentence for run summaries, "Odometry sensor (...): ...": how far the sensor's estimate is
+/// from `truth` (position of A [m], heading [rad]) against its covariance's standard deviations.
 std::string odometry_drift_line(const OdometrySensor& sensor, const CartState& truth, const CartModel& model);
 
 }  // namespace birkhoff_cart
