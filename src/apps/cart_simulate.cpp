@@ -10,7 +10,9 @@
 // units; energy is T* [J], p2 the front axle's yaw momentum [kg·m²/s], local_error_estimate the
 // last step's ê [-], empty when the integrator has none: docs/accuracy.md), and with the scene's
 // odometry sensor on, odom_x,odom_y,odom_theta,odom_sigma_position,odom_sigma_theta (its estimate of
-// A and θ, read at every row, and their standard deviations: docs/odometry_sensor.md); one row per output
+// A and θ, read at every row, and their standard deviations: docs/odometry_sensor.md), with its
+// actuators steering_torque_applied, drive_torque_applied [N·m] and with its steering end stops
+// end_stop_contact (+1 on +χ_s, −1 on −χ_s, 0 free: docs/actuators.md); one row per output
 // instant t0 + k/HZ from the start to the end, both included; values printed with %.17g
 // (round-trip exact). At the end a summary goes to stdout, with the accuracy guard's verdict
 // (the scene's `accuracy` limits, checked at every row). The run is cut
@@ -238,6 +240,11 @@ void write_row(std::FILE* file, double time, const Simulation& simulation, birkh
                  std::sqrt(odometry.pose_covariance(0, 0) + odometry.pose_covariance(1, 1)),
                  std::sqrt(odometry.pose_covariance(2, 2)));
   }
+  // The actuators' applied torques and the end-stop contact (docs/actuators.md), when enabled.
+  const Simulation::ActuatorStatus actuators = simulation.actuator_status();
+  if (actuators.steering_actuator) std::fprintf(file, ",%.17g", actuators.steering_applied);
+  if (actuators.drive_actuator) std::fprintf(file, ",%.17g", actuators.drive_applied);
+  if (actuators.end_stops) std::fprintf(file, ",%d", actuators.end_stop_contact);
   std::fprintf(file, "\n");
   guard.check(time, simulation.diagnostics(), statistics);
 }
@@ -325,8 +332,10 @@ int run(int argc, char** argv) {
     sensor.emplace(*scene.odometry_sensor, simulation->model());
     sensor->start(simulation->state(), true);
   }
-  std::fprintf(file, "t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,local_error_estimate%s\n",
-               sensor ? ",odom_x,odom_y,odom_theta,odom_sigma_position,odom_sigma_theta" : "");
+  std::fprintf(file, "t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,local_error_estimate%s%s%s%s\n",
+               sensor ? ",odom_x,odom_y,odom_theta,odom_sigma_position,odom_sigma_theta" : "",
+               scene.actuators.steering ? ",steering_torque_applied" : "",
+               scene.actuators.drive ? ",drive_torque_applied" : "", scene.actuators.end_stops ? ",end_stop_contact" : "");
   const birkhoff_cart::StepSchedule& schedule = simulation->schedule();
   const double start_time = schedule.start_time;  // t0 [s]
   birkhoff_cart::AccuracyGuard guard(scene.accuracy);

@@ -3,7 +3,10 @@
 //   Q = EffectSet::evaluate (via generalized_force),  ω̇ = M⁻¹(Q − h)  (eq. (3.4)),
 //   (ẋ, ẏ, θ̇, φ̇)  (eqs. (2.3)–(2.4)),
 // and a scene that lists every effect with `enabled: false` (which must cost what the free cart
-// costs). Median of the repetitions after a warm-up; a volatile sink keeps the work alive.
+// costs). Then the cost of a whole birkhoff_gauss4 step with commanded torques, without actuators,
+// with the steering and drive actuators of docs/actuators.md, and with the steering end stops too
+// (which must add nothing while the axle is free and nothing at all when the scene has no sections).
+// Median of the repetitions after a warm-up; a volatile sink keeps the work alive.
 //
 // Usage: effects_benchmark [evaluations_per_repetition=200000] [repetitions=7]
 #include <unistd.h>
@@ -26,6 +29,7 @@
 #include "birkhoff_cart/core/effect_library.h"
 #include "birkhoff_cart/core/effects.h"
 #include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/simulation.h"
 #include "birkhoff_cart/core/version.h"
 
 namespace {
@@ -128,6 +132,70 @@ Scene load_all_disabled_scene() {
   return scene;
 }
 
+/// Wall time of one Simulation::step of `scene` with commands that change every 10 steps [ns per step].
+double median_step_time(const Scene& scene, long steps, int repetitions) {
+  std::vector<double> times;
+  for (int repetition = 0; repetition <= repetitions; ++repetition) {  // the first is the warm-up
+    Simulation simulation(scene);
+    const auto start = std::chrono::steady_clock::now();
+    for (long k = 0; k < steps; ++k) {
+      if (k % 10 == 0) {
+        simulation.set_steering_command(0.4 * std::sin(0.01 * static_cast<double>(k)));  // [N·m]
+        simulation.set_drive_command(3.0 + std::cos(0.01 * static_cast<double>(k)));     // [N·m]
+      }
+      simulation.step();
+    }
+    const auto stop = std::chrono::steady_clock::now();
+    g_sink = g_sink + simulation.state().x;
+    if (repetition > 0) times.push_back(std::chrono::duration<double, std::nano>(stop - start).count() / steps);
+  }
+  std::sort(times.begin(), times.end());
+  return times[times.size() / 2];
+}
+
+/// The step-cost table: commanded torques without actuators, with them, with end stops too.
+void print_actuator_costs(const Scene& base, long steps, int repetitions) {
+  Scene scene = base;
+  scene.integrator.name = "birkhoff_gauss4";
+  scene.integrator.step_size = 0.01;  // [s]
+  scene.duration = 0.01 * static_cast<double>(steps) + 1.0;
+  scene.initial_state.steering_rate = 0.0;
+  scene.effects.clear();
+  EffectSpec steering;
+  steering.name = "steering_torque";
+  steering.profile.kind = TorqueProfile::Kind::kCommand;
+  EffectSpec drive = steering;
+  drive.name = "drive_torque";
+  scene.effects = {steering, drive, coefficients("steering_damping", {{"coefficient", 2.0}})};
+  TorqueActuatorSettings motor;
+  motor.time_constant = 0.1;  // [s]
+  motor.dead_time = 0.025;    // [s], not a multiple of h: each command's response ends a sub-step
+  motor.rate_limit = 10.0;    // [N·m/s]
+  motor.torque_limit = 4.0;   // [N·m]
+  motor.dead_band = 0.02;     // [N·m]
+
+  std::printf("\nOne birkhoff_gauss4 step (h = 0.01 s) with commanded torques changing every 10 steps, %ld steps x %d "
+              "repetitions, median\n\n",
+              steps, repetitions);
+  std::printf("%-44s  %12s  %14s\n", "scene", "ns/step", "ratio to none");
+  const double none = median_step_time(scene, steps, repetitions);
+  std::printf("%-44s  %12.1f  %14.2f\n", "no actuator sections", none, 1.0);
+  Scene stops_only = scene;
+  stops_only.actuators.end_stops = SteeringEndStopSettings{0.6, 0.0};
+  const double stops = median_step_time(stops_only, steps, repetitions);
+  std::printf("%-44s  %12.1f  %14.2f\n", "steering_end_stops (axle free)", stops, stops / none);
+  Scene actuated = scene;
+  actuated.actuators.steering = motor;
+  actuated.actuators.drive = motor;
+  const double motors = median_step_time(actuated, steps, repetitions);
+  std::printf("%-44s  %12.1f  %14.2f\n", "steering_actuator + drive_actuator", motors, motors / none);
+  actuated.actuators.end_stops = stops_only.actuators.end_stops;
+  const double all = median_step_time(actuated, steps, repetitions);
+  std::printf("%-44s  %12.1f  %14.2f\n", "both actuators + steering_end_stops", all, all / none);
+  const double none_again = median_step_time(scene, steps, repetitions);
+  std::printf("%-44s  %12.1f  %14.2f\n", "no actuator sections, again", none_again, none_again / none);
+}
+
 /// A whole number in [low, high] from `text`, or -1 (not a number, trailing junk or out of range).
 long parse_count(const char* text, long low, long high) {
   errno = 0;
@@ -193,6 +261,7 @@ int run(int argc, char** argv) {
   // Re-time the free cart last, so drift of the machine during the run shows.
   const double free_again = median_time(model, build_effects({}, model), samples, evaluations, repetitions);
   std::printf("%-2d  %-26s  %12.1f  %14.2f\n", 0, "(free cart, again)", free_again, free_again / free_cart);
+  print_actuator_costs(disabled, std::max(100L, evaluations / 100), repetitions);
   std::printf("\nsink %.6g\n", static_cast<double>(g_sink));
   return 0;
 }

@@ -27,6 +27,10 @@ void compare_states(const CartState& state, const CartState& reference, Diagnost
   diagnostics.reference_arc_length_relative_error = relative_error(state.arc_length, reference.arc_length);
 }
 
+void ReferenceSolution::restart_at(const CartState& /*state*/) {
+  throw std::logic_error("this reference cannot restart at a simulation event (end stops need reference none or shadow_run)");
+}
+
 namespace {
 
 /// The paper's special case against its closed form (docs eq. (3.9)).

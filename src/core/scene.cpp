@@ -176,7 +176,8 @@ Scene read_scene(const SceneReader& reader, const YAML::Node& root, const std::s
   if (!root || root.IsNull()) reader.fail("(document)", "is empty");
   reader.require_map(root, "",
                      {"description", "cart", "paper_special_case", "initial_state", "duration", "integrator",
-                      "output_rate", "effects", "reference", "accuracy", "odometry_sensor"});
+                      "output_rate", "effects", "reference", "accuracy", "odometry_sensor", "steering_actuator",
+                      "drive_actuator", "steering_end_stops"});
   Scene scene;
   scene.name = file_stem(path);
   scene.source_path = path;
@@ -202,6 +203,17 @@ Scene read_scene(const SceneReader& reader, const YAML::Node& root, const std::s
   scene.reference = read_reference(reader, root["reference"], scene.paper_special_case);
   scene.accuracy = scene_detail::read_accuracy(reader, root["accuracy"]);
   scene.odometry_sensor = scene_detail::read_odometry_sensor(reader, root["odometry_sensor"]);
+  scene.actuators = scene_detail::read_actuators(reader, root);
+  if (scene.actuators.end_stops) {
+    if (scene.reference.kind == ReferenceSettings::Kind::kPaperAnalytic) {
+      reader.fail("steering_end_stops", "cannot go with reference paper_analytic (its closed form has no stops); use "
+                                        "shadow_run or none");
+    }
+    if (std::abs(scene.initial_state.steering_angle) > scene.actuators.end_stops->angle) {
+      reader.fail("initial_state.steering_angle", "lies beyond the steering end stops at +-" +
+                                                      std::to_string(scene.actuators.end_stops->angle) + " rad");
+    }
+  }
 
   // The cart must give a usable mass matrix (only the declared paper case may be singular).
   if (scene.paper_special_case && scene.cart.wheelbase != 1.0) {
@@ -210,12 +222,17 @@ Scene read_scene(const SceneReader& reader, const YAML::Node& root, const std::s
   try {
     const CartModel model(scene.cart, scene.paper_special_case ? InertiaModel::kPaperSpecialCase
                                                                : InertiaModel::kPhysical);
-    build_effects(scene.effects, model);  // the effects accept their coefficients
+    // the effects accept their coefficients, the actuators their inputs
+    build_effects(scene.effects, model, scene.actuators, scene.initial_state.time);
   } catch (const SceneError&) {
     throw;
   } catch (const std::invalid_argument& error) {
     const std::string message = error.what();
-    reader.fail(message.rfind("effect", 0) == 0 ? "effects" : "cart", one_line(message));
+    std::string key = "cart";
+    for (const char* section : {"effect", "steering_actuator", "drive_actuator", "steering_end_stops"}) {
+      if (message.rfind(section, 0) == 0) key = std::string(section) == "effect" ? "effects" : section;
+    }
+    reader.fail(key, one_line(message));
   }
   return scene;
 }

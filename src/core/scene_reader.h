@@ -65,6 +65,9 @@ std::vector<EffectSpec> read_effects(const SceneReader& reader, const YAML::Node
 /// Reads the optional `odometry_sensor` map: absent, the sensor is off.
 std::optional<OdometrySensorSettings> read_odometry_sensor(const SceneReader& reader, const YAML::Node& node);
 
+/// Reads the optional steering_actuator, drive_actuator and steering_end_stops maps of the root.
+ActuatorSettings read_actuators(const SceneReader& reader, const YAML::Node& root);
+
 /// Reads the optional `accuracy` map over the defaults of AccuracyRequirements.
 AccuracyRequirements read_accuracy(const SceneReader& reader, const YAML::Node& accuracy);
 

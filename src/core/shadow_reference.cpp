@@ -100,6 +100,8 @@ class DenseShadowReference : public ReferenceSolution {
     restart(state_at(time), step_size_guess);
   }
 
+  void restart_at(const CartState& state) override { restart(state, stepper_.current_time_step()); }
+
   void compare(const CartState& state, Diagnostics& diagnostics) const override {
     compare_states(state, state_at(state.time), diagnostics);
   }
@@ -160,6 +162,8 @@ class SubstepShadowReference : public ReferenceSolution {
     state_ = next;
     statistics_ = statistics;
   }
+
+  void restart_at(const CartState& state) override { state_ = state; }
 
   void reset() override {
     stepper_ = make_cart_stepper(settings_, model_, effects_);  // forgets adaptive step-size guesses

@@ -4,6 +4,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "birkhoff_cart/core/actuators/steering_end_stops.h"
+#include "birkhoff_cart/core/actuators/torque_actuator.h"
 #include "birkhoff_cart/core/effect_library.h"
 #include "birkhoff_cart/core/reference_solution.h"
 #include "birkhoff_cart/core/singular_steering.h"
@@ -44,7 +46,7 @@ IntegratorSettings integrator_settings(const Scene& scene) {
 Simulation::Simulation(const Scene& scene)
     : scene_(scene),
       model_(scene.cart, inertia_model_of(scene)),
-      effects_(build_effects(scene.effects, model_)),
+      effects_(build_effects(scene.effects, model_, scene.actuators, scene.initial_state.time)),
       stepper_(make_cart_stepper(integrator_settings(scene), model_, effects_)),
       state_(scene.initial_state),
       schedule_(plan_steps(scene.initial_state.time, scene.duration, scene.integrator.step_size)),
@@ -93,6 +95,10 @@ void Simulation::step_to(double time) {
 }
 
 void Simulation::take_step(double h, double next_time) {
+  if (effects_.steering_actuator() || effects_.drive_actuator() || effects_.end_stops()) {
+    take_step_with_events(next_time);
+    return;
+  }
   CartState next = state_;
   StepStatistics statistics = statistics_;
   check_singular_steering(model_, state_, h);  // paper case: refuse a step onto χ = kπ (docs/hard_cases.md §1)
@@ -113,6 +119,7 @@ void Simulation::advance_to(double time) {
 void Simulation::reset() {
   Scene loaded = scene_;
   loaded.initial_state = loaded_initial_state_;  // also after restart_from(): the loaded scene's start
+  start_actuators(effects_, loaded.effects, loaded.initial_state.time);  // before the pilots of start_run
   start_run(std::move(loaded));
   if (effects_.steering_command()) effects_.steering_command()->value = initial_command(scene_, "steering_torque");
   if (effects_.drive_command()) effects_.drive_command()->value = initial_command(scene_, "drive_torque");
@@ -138,12 +145,24 @@ void Simulation::restart_from(const CartState& initial_state) {
   } catch (const StepError& error) {
     throw std::invalid_argument(std::string("restart state: ") + error.what());
   }
+  if (const auto& stops = effects_.end_stops()) {
+    if (stops->penetration(initial_state.steering_angle) > 0.0) {
+      std::ostringstream message;
+      message << "restart state: steering_angle " << initial_state.steering_angle << " rad lies beyond the end stops at +-"
+              << stops->settings().angle << " rad";
+      throw std::invalid_argument(message.str());
+    }
+  }
   Scene restarted = scene_;
   restarted.initial_state = initial_state;
   // The balances' integrals run from the run's start (docs eq. (3.7), (3.8)): a restart is one.
   restarted.initial_state.applied_work = 0.0;
   restarted.initial_state.steering_impulse = 0.0;
   start_run(std::move(restarted));
+  // The actuators keep their torques and pending inputs (a teleport moves the cart, not its motors).
+  if (effects_.steering_actuator()) effects_.steering_actuator()->retime(scene_.initial_state.time);
+  if (effects_.drive_actuator()) effects_.drive_actuator()->retime(scene_.initial_state.time);
+  if (effects_.end_stops()) effects_.end_stops()->set_contact(SteeringEndStops::Contact::kNone);
 }
 
 void Simulation::start_run(Scene run_scene) {
@@ -164,6 +183,7 @@ void Simulation::start_run(Scene run_scene) {
   state_ = state;
   statistics_ = statistics;
   steps_taken_ = 0;
+  end_stop_events_ = 0;
   finished_off_grid_ = false;
   initial_energy_ = model_.energy(state_);
   initial_steering_momentum_ = model_.steering_momentum(state_);
@@ -178,6 +198,7 @@ void Simulation::set_steering_command(double torque) {
   }
   require_finite_torque(torque, "steering");
   if (reference_ && effects_.steering_command()->value != torque) reference_->command_changes(state_.time);
+  if (effects_.steering_actuator()) effects_.steering_actuator()->command(state_.time, torque);
   effects_.steering_command()->value = torque;
 }
 
@@ -187,6 +208,7 @@ void Simulation::set_drive_command(double torque) {
   }
   require_finite_torque(torque, "drive");
   if (reference_ && effects_.drive_command()->value != torque) reference_->command_changes(state_.time);
+  if (effects_.drive_actuator()) effects_.drive_actuator()->command(state_.time, torque);
   effects_.drive_command()->value = torque;
 }
 

@@ -96,6 +96,22 @@ void CartSimNode::produce_diagnostics(diagnostic_updater::DiagnosticStatusWrappe
   };
   add_channel("steering_torque", steering_channel_);
   add_channel("drive_torque", drive_channel_);
+  // The actuators' state (docs/actuators.md): what was commanded, what the cart receives.
+  const Simulation::ActuatorStatus actuators = simulation_->actuator_status();
+  if (actuators.steering_actuator) {
+    status.add("steering actuator input [N m]", actuators.steering_input);
+    status.add("steering actuator applied [N m]", actuators.steering_applied);
+  }
+  if (actuators.drive_actuator) {
+    status.add("drive actuator input [N m]", actuators.drive_input);
+    status.add("drive actuator applied [N m]", actuators.drive_applied);
+  }
+  if (actuators.end_stops) {
+    status.add("steering end stop contact", actuators.end_stop_contact == 0 ? std::string("free")
+                                            : actuators.end_stop_contact > 0 ? std::string("upper")
+                                                                             : std::string("lower"));
+    status.add("steering end stop events", actuators.end_stop_events);
+  }
 }
 
 double CartSimNode::real_time_factor(WallClockPacing::Clock::time_point now) const {

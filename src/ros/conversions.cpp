@@ -208,6 +208,10 @@ ActuatorEfforts actuator_efforts(const Simulation& simulation) {
   if (const TorqueProfile* drive = find_profile(simulation.scene(), "drive_torque")) {
     efforts.drive_torque = simulation.accepts_drive_command() ? simulation.drive_command() : drive->at(time);
   }
+  // With actuators the joints feel what the actuators apply, not what was commanded (docs/actuators.md).
+  const Simulation::ActuatorStatus actuators = simulation.actuator_status();
+  if (actuators.steering_actuator) efforts.steering_torque = actuators.steering_applied;
+  if (actuators.drive_actuator) efforts.drive_torque = actuators.drive_applied;
   return efforts;
 }
 

@@ -108,6 +108,9 @@ INSTANTIATE_TEST_SUITE_P(
                  "birkhoff_gauss4", 1e-2},
         SceneRow{"noisy_odometry", 0.0, 1.0, 0.0, 60.0,
                  {"drive_torque", "rolling_resistance", "air_drag", "steering_torque", "steering_damping"},
+                 "birkhoff_gauss4", 1e-2},
+        SceneRow{"steering_actuator", 0.0, 1.0, 0.0, 20.0,
+                 {"drive_torque", "rolling_resistance", "air_drag", "steering_torque", "steering_damping"},
                  "birkhoff_gauss4", 1e-2}),
     [](const ::testing::TestParamInfo<SceneRow>& info) { return info.param.name; });
 
@@ -147,6 +150,23 @@ TEST(ShippedScenes, EffectParametersMatchTheTable) {
   EXPECT_EQ(slalom.reference.shadow.tolerance, 1e-12);
   EXPECT_EQ(load_scene(scene_path("free_coast")).reference.kind, ReferenceSettings::Kind::kNone);
   EXPECT_FALSE(slalom.odometry_sensor.has_value());  // odom is the exact state unless a scene says otherwise
+  EXPECT_FALSE(slalom.actuators.any());              // commands reach the cart unchanged unless a scene says otherwise
+
+  const Scene motors = load_scene(scene_path("steering_actuator"));  // docs/scenes.md's row
+  ASSERT_TRUE(motors.actuators.steering && motors.actuators.drive && motors.actuators.end_stops);
+  EXPECT_EQ(motors.actuators.steering->time_constant, 0.1);
+  EXPECT_EQ(motors.actuators.steering->dead_time, 0.025);
+  EXPECT_EQ(motors.actuators.steering->rate_limit, 10.0);
+  EXPECT_EQ(motors.actuators.steering->torque_limit, 2.0);
+  EXPECT_EQ(motors.actuators.steering->dead_band, 0.05);
+  EXPECT_EQ(motors.actuators.drive->time_constant, 0.5);
+  EXPECT_EQ(motors.actuators.drive->torque_limit, 4.0);
+  EXPECT_EQ(motors.actuators.drive->dead_time, 0.0);
+  EXPECT_EQ(motors.actuators.end_stops->angle, 0.6);
+  EXPECT_EQ(motors.actuators.end_stops->restitution, 0.0);
+  EXPECT_EQ(find_effect(motors, "steering_torque")->profile.kind, TorqueProfile::Kind::kStep);
+  EXPECT_EQ(find_effect(motors, "steering_torque")->profile.final, 3.0);
+  EXPECT_EQ(find_effect(motors, "drive_torque")->profile.final, 6.0);
 
   const Scene noisy = load_scene(scene_path("noisy_odometry"));  // the table's sensor settings
   ASSERT_TRUE(noisy.odometry_sensor.has_value());

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "birkhoff_cart/core/actuators/actuator_settings.h"
 #include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/effects.h"
 #include "birkhoff_cart/core/effect_spec.h"
@@ -27,5 +28,17 @@ const std::vector<std::string>& effect_coefficient_names(const std::string& effe
 /// Throws std::invalid_argument naming an unknown effect, a duplicated effect, a missing or
 /// unknown coefficient, or a bad coefficient/profile value (non-finite, negative, zero width ...).
 EffectSet build_effects(const std::vector<EffectSpec>& specs, const CartModel& model);
+
+/// As above, with the scene's actuators between the inputs and the torque effects and its steering
+/// end stops (docs/actuators.md), the actuators at rest at `start_time` [s]. An actuator needs its
+/// torque effect with a piecewise-constant input (source command, or a constant or step profile);
+/// std::invalid_argument names the section otherwise.
+EffectSet build_effects(const std::vector<EffectSpec>& specs, const CartModel& model, const ActuatorSettings& actuators,
+                        double start_time);
+
+/// Puts the actuators of `effects` at rest at `start_time` [s] with their initial inputs (the
+/// command's initial value or the profile's value there, a step profile's later step pending), and
+/// the end stops out of contact (a run's start: reset()).
+void start_actuators(const EffectSet& effects, const std::vector<EffectSpec>& specs, double start_time);
 
 }  // namespace birkhoff_cart

@@ -15,6 +15,9 @@
 
 namespace birkhoff_cart {
 
+class SteeringEndStops;
+class TorqueActuator;
+
 /// Where an effect reads the state: time and the reduced velocity state.
 struct EffectInput {
   double time = 0.0;            ///< t [s]
@@ -81,15 +84,18 @@ class EffectSet {
   std::size_t size() const { return effects_.size(); }
   const std::vector<std::unique_ptr<Effect>>& effects() const { return effects_; }
 
-  /// Sum of all enabled effects (zero for the free cart).
+  /// Sum of all enabled effects (zero for the free cart), with the end stops' holding reaction
+  /// while the steering axle rests on a stop (docs/actuators.md eq. (S2)).
   GeneralizedForce evaluate(const EffectInput& input) const;
+  /// Sum of the effects alone, without the end stops' reaction.
+  GeneralizedForce evaluate_loads(const EffectInput& input) const;
 
   /// Q as scalars of type S: plain values for double, values with derivatives propagated through
   /// the analytic Jacobian for AD scalars (t is never differentiated).
   template <class S>
   Vector2<S> generalized_force(double time, const S& steering_angle, const Vector2<S>& quasi_velocity) const {
     Vector2<S> result;
-    if (effects_.empty()) {
+    if (effects_.empty() && !end_stops_) {
       result.setConstant(S(0.0) * steering_angle);
       return result;
     }
@@ -113,10 +119,22 @@ class EffectSet {
   void set_steering_command_input(std::shared_ptr<CommandInput> input) { steering_command_ = std::move(input); }
   void set_drive_command_input(std::shared_ptr<CommandInput> input) { drive_command_ = std::move(input); }
 
+  /// The actuators between the commands (or piecewise-constant profiles) and the torque effects, and
+  /// the steering end stops, when the scene enables them (nullptr otherwise; docs/actuators.md).
+  std::shared_ptr<TorqueActuator> steering_actuator() const { return steering_actuator_; }
+  std::shared_ptr<TorqueActuator> drive_actuator() const { return drive_actuator_; }
+  std::shared_ptr<SteeringEndStops> end_stops() const { return end_stops_; }
+  void set_steering_actuator(std::shared_ptr<TorqueActuator> actuator) { steering_actuator_ = std::move(actuator); }
+  void set_drive_actuator(std::shared_ptr<TorqueActuator> actuator) { drive_actuator_ = std::move(actuator); }
+  void set_end_stops(std::shared_ptr<SteeringEndStops> stops) { end_stops_ = std::move(stops); }
+
  private:
   std::vector<std::unique_ptr<Effect>> effects_;
   std::shared_ptr<CommandInput> steering_command_;
   std::shared_ptr<CommandInput> drive_command_;
+  std::shared_ptr<TorqueActuator> steering_actuator_;
+  std::shared_ptr<TorqueActuator> drive_actuator_;
+  std::shared_ptr<SteeringEndStops> end_stops_;
 };
 
 }  // namespace birkhoff_cart

@@ -44,6 +44,11 @@ class ReferenceSolution {
   /// been stepped to it): a reference that integrates the commands must reach `time` with the old
   /// command held. Default: nothing.
   virtual void command_changes(double /*time*/) {}
+  /// The simulation jumped at `state.time` (an end-stop impact or release, docs/actuators.md §3.3;
+  /// the reference has been stepped to that time): continue from the simulation's `state`, so the
+  /// reference judges the integration error since the latest event. Default: std::logic_error (a
+  /// closed-form reference cannot follow; the scene loader refuses end stops with it).
+  virtual void restart_at(const CartState& state);
   /// Fills the reference fields of `diagnostics` for the simulated `state`.
   virtual void compare(const CartState& state, Diagnostics& diagnostics) const = 0;
 };

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "birkhoff_cart/core/accuracy_guard.h"
+#include "birkhoff_cart/core/actuators/actuator_settings.h"
 #include "birkhoff_cart/core/effect_spec.h"
 #include "birkhoff_cart/core/integrator_settings.h"
 #include "birkhoff_cart/core/parameters.h"
@@ -53,6 +54,9 @@ struct Scene {
   /// The `odometry_sensor` section: odometry from simulated encoders (docs/odometry_sensor.md);
   /// none = odometry is the exact state.
   std::optional<OdometrySensorSettings> odometry_sensor;
+  /// The `steering_actuator`, `drive_actuator` and `steering_end_stops` sections (docs/actuators.md);
+  /// none = commands reach the cart unchanged and χ has no stops.
+  ActuatorSettings actuators;
 };
 
 /// Loads and validates a scene. Throws SceneError naming the file and the key.

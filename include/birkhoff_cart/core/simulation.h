@@ -84,6 +84,20 @@ class Simulation {
   double steering_command() const;           ///< the torque in force [N·m]
   double drive_command() const;              ///< the torque in force [N·m]
 
+  /// The actuators' and end stops' state (all zero/false when the scene enables none).
+  struct ActuatorStatus {
+    bool steering_actuator = false;     ///< the scene has a steering actuator
+    double steering_input = 0.0;        ///< latest commanded steering torque [N·m]
+    double steering_applied = 0.0;      ///< steering torque the hinge receives now [N·m]
+    bool drive_actuator = false;        ///< the scene has a drive actuator
+    double drive_input = 0.0;           ///< latest commanded drive torque [N·m]
+    double drive_applied = 0.0;         ///< drive torque the rear axle receives now [N·m]
+    bool end_stops = false;             ///< the scene has steering end stops
+    int end_stop_contact = 0;           ///< +1 resting on +χ_s, −1 on −χ_s, 0 free
+    std::uint64_t end_stop_events = 0;  ///< impacts and releases since the run's start [-]
+  };
+  ActuatorStatus actuator_status() const;
+
   /// Invariants and errors of the current state (reference error only when the scene asks).
   Diagnostics diagnostics() const;
   const StepStatistics& statistics() const { return statistics_; }
@@ -97,6 +111,10 @@ class Simulation {
   StepSchedule schedule_;
   CartState loaded_initial_state_;  ///< the loaded scene's initial state, for reset()
   void take_step(double step_size, double next_time);
+  /// take_step with actuators or end stops: ends sub-steps at the actuators' kinks and at end-stop
+  /// events (docs/actuators.md §4).
+  void take_step_with_events(double next_time);
+  std::uint64_t end_stop_events_ = 0;
   /// Builds the schedule, reference and stepper of a run of `run_scene` from its initial state and
   /// commits them with zeroed counters and the invariants' initial values (reset(), restart_from()).
   /// Throws, with nothing changed, when the reference or the reversible control refuses the state.

@@ -3,6 +3,8 @@
 
 #include "birkhoff_cart/core/effects.h"
 
+#include "birkhoff_cart/core/actuators/steering_end_stops.h"
+
 namespace birkhoff_cart {
 
 void EffectSet::add(std::unique_ptr<Effect> effect) {
@@ -10,9 +12,15 @@ void EffectSet::add(std::unique_ptr<Effect> effect) {
   effects_.push_back(std::move(effect));
 }
 
-GeneralizedForce EffectSet::evaluate(const EffectInput& input) const {
+GeneralizedForce EffectSet::evaluate_loads(const EffectInput& input) const {
   GeneralizedForce total;  // Q = 0, ∂Q/∂(χ, ω) = 0 for the free cart
   for (const auto& effect : effects_) effect->add_to(input, total);
+  return total;
+}
+
+GeneralizedForce EffectSet::evaluate(const EffectInput& input) const {
+  GeneralizedForce total = evaluate_loads(input);
+  if (end_stops_) end_stops_->add_reaction(input, total);
   return total;
 }
 
