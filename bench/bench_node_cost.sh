@@ -3,8 +3,8 @@
 # (the cheapest Birkhoffian 1 kHz stepping; the scene itself now defaults to birkhoff_gauss4 at 10 ms,
 # 100 Hz publishing, its dopri5 shadow reference on) in fast mode for 300 s of scene time, with and
 # without the bag, beside cart_simulate on the same scene and duration (the bare core with CSV at
-# 100 Hz), three times each; then lockstep with steering_pd_controller (driven.yaml, 60 s at 50 Hz)
-# and real-time mode at 1 kHz (CPU share of one core over 15 s of wall time). Also the default
+# 100 Hz), three times each; then lockstep with steering_pd_controller (driven.yaml, 60 s at 50 Hz),
+# as two processes and as nodelets in one manager, and real-time mode at 1 kHz (CPU share of one core over 15 s of wall time). Also the default
 # scene as shipped (birkhoff_gauss4 at h = 10 ms) with and without the bag beside cart_simulate,
 # and the bag uncompressed (~bag_compression none) once.
 # Ratios: scene time / wall time (the node's from its own summary: its time loop), and CPU time
@@ -108,6 +108,22 @@ timed "$work/lockstep.time" "$bin/cart_sim" __name:=cart_sim _scene:="$repo/conf
 kill -INT "$controller_pid" 2>/dev/null || true
 wait "$controller_pid" 2>/dev/null || true
 echo "lockstep (driven.yaml, 60 s at 50 Hz with steering_pd_controller): $(grep -o 'real-time factor [0-9.e+]*' "$work/lockstep.summary") of the loop; $(grep -o 'Lockstep timeouts: [0-9]*' "$work/lockstep.summary"); process wall/user/sys $(cat "$work/lockstep.time")"
+
+# The same loop as nodelets in one manager (zero-copy messages): the summary appears when the run ends.
+rosparam delete /cart_sim > /dev/null 2>&1 || true
+/usr/lib/nodelet/nodelet manager __name:=loop_manager > "$work/manager.log" 2>&1 &
+manager_pid=$!
+/usr/lib/nodelet/nodelet load birkhoff_cart/SteeringPdController loop_manager __name:=pd > "$work/pd_nodelet.log" 2>&1 &
+pd_loader=$!
+/usr/lib/nodelet/nodelet load birkhoff_cart/CartSim loop_manager __name:=cart_sim _scene:="$repo/config/scenes/driven.yaml" \
+  _fast:=true _lockstep:=true _publish_rate:=50 _duration:=60 _summary_path:="$work/nodelet.summary" > "$work/nodelet.log" 2>&1 &
+sim_loader=$!
+for _ in $(seq 1200); do grep -q 'Lockstep timeouts' "$work/nodelet.summary" 2>/dev/null && break; sleep 0.1; done
+kill -INT "$sim_loader" "$pd_loader" 2>/dev/null || true
+wait "$sim_loader" "$pd_loader" 2>/dev/null || true
+kill -INT "$manager_pid" 2>/dev/null || true
+wait "$manager_pid" 2>/dev/null || true
+echo "lockstep as nodelets in one manager (same loop): $(grep -o 'real-time factor [0-9.e+]*' "$work/nodelet.summary") of the loop; $(grep -o 'Lockstep timeouts: [0-9]*' "$work/nodelet.summary")"
 
 # Real time at 1 kHz: CPU share of one core over 15 s after a 3 s start-up.
 rosparam delete /cart_sim > /dev/null 2>&1 || true

@@ -27,6 +27,8 @@ packages=(
   # the tf command-line tools beside the simulator: `rosrun tf tf_echo odom base_link`,
   # `rosrun tf2_tools echo.py`, `rosrun tf2_tools view_frames.py` (tf_tools.test)
   tf-tools libtf-dev tf2-tools
+  # the nodelets (nodelet_plugins.xml) and `rosrun nodelet nodelet manager`
+  libnodeletlib-dev libnodelet-dev libnodeletlib-tools pluginlib-dev
   # cmd_vel_controller's run-time settings (cfg/CmdVelController.cfg; `rosrun dynamic_reconfigure dynparam`)
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   libboost-dev libyaml-cpp-dev libeigen3-dev googletest libgtest-dev

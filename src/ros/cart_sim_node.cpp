@@ -262,7 +262,7 @@ double CartSimNode::next_step_time() const {
   return simulation_->state().time + simulation_->step_size();
 }
 
-bool CartSimNode::stop_requested() const { return shutdown_signal_received() || !ros::ok(); }
+bool CartSimNode::stop_requested() const { return stop_flag_ || shutdown_signal_received() || !ros::ok(); }
 
 bool CartSimNode::take_step() {
   apply_watchdogs();

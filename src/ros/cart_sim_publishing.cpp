@@ -3,7 +3,21 @@
 
 #include "birkhoff_cart/ros/instant_schedule.h"
 
+#include <boost/make_shared.hpp>
+
 namespace birkhoff_cart {
+namespace {
+
+/// Publishes a shared copy of `message`: a subscriber in the same process (a controller nodelet in
+/// cart_sim's manager) gets that copy without serialization; remote subscribers are served as by
+/// publish(message). Nothing when no one subscribes.
+template <class Message>
+void publish_shared(const ros::Publisher& publisher, const Message& message) {
+  if (publisher.getNumSubscribers() == 0) return;
+  publisher.publish(boost::make_shared<Message>(message));
+}
+
+}  // namespace
 
 void CartSimNode::publish_clock(double time) {
   if (!parameters_.publish_clock) return;
@@ -26,9 +40,10 @@ void CartSimNode::publish_instant() {
   const OdometryEstimate* estimate = odometry_sensor_ ? &odometry_sensor_->read(simulation_->state()) : nullptr;
   messages.fill(*simulation_, accuracy_guard_, last_wall_time_per_step_, estimate);
 
-  ground_truth_publisher_.publish(messages.ground_truth);
-  odometry_publisher_.publish(messages.odometry);
-  joint_state_publisher_.publish(messages.joints);
+  // The controllers' inputs as shared messages (zero-copy in a nodelet manager).
+  publish_shared(ground_truth_publisher_, messages.ground_truth);
+  publish_shared(odometry_publisher_, messages.odometry);
+  publish_shared(joint_state_publisher_, messages.joints);
   integration_error_publisher_.publish(messages.integration_error);
   // odom → base_link, once per stamp; also into the bag, so a replay in rviz places the cart.
   const ros::Time stamp = messages.odometry.header.stamp;

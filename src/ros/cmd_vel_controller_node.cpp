@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <boost/make_shared.hpp>
 #include <std_msgs/Float64.h>
 
 #include "birkhoff_cart/core/closest_name.h"
@@ -90,9 +91,10 @@ CmdVelControllerSettings load_cmd_vel_controller_settings(const ros::NodeHandle&
   return s;
 }
 
-CmdVelControllerNode::CmdVelControllerNode(ros::NodeHandle node, ros::NodeHandle private_node)
+CmdVelControllerNode::CmdVelControllerNode(ros::NodeHandle node, ros::NodeHandle private_node, bool shut_down_on_refusal)
     : node_(node),
       private_node_(private_node),
+      shut_down_on_refusal_(shut_down_on_refusal),
       controller_(load_cmd_vel_controller_settings(private_node)),
       steering_joint_(private_node.param<std::string>("steering_joint", "steering_joint")) {
   steering_publisher_ = node_.advertise<std_msgs::Float64>("steering_torque", 10);
@@ -198,7 +200,13 @@ void CmdVelControllerNode::check_joint_names(const ros::WallTimerEvent&) {
              ": without the steering angle the controller cannot steer, so it does not run";
   ROS_FATAL("cmd_vel_controller: %s", refusal_.c_str());
   joint_check_.stop();
-  ros::shutdown();
+  if (shut_down_on_refusal_) {
+    ros::shutdown();
+  } else {  // a nodelet: the manager and its other nodelets go on
+    cmd_vel_subscriber_.shutdown();
+    odometry_subscriber_.shutdown();
+    joint_state_subscriber_.shutdown();
+  }
 }
 
 void CmdVelControllerNode::on_odometry(const nav_msgs::Odometry::ConstPtr& message) {
@@ -247,11 +255,13 @@ void CmdVelControllerNode::update_if_complete() {
              controller_.settings().cmd_vel_timeout, feedback.time);
     timeout_reported_ = true;
   }
-  std_msgs::Float64 torque;
-  torque.data = command.steering_torque;
-  steering_publisher_.publish(torque);
-  torque.data = command.drive_torque;
-  drive_publisher_.publish(torque);
+  // Shared messages: zero-copy to cart_sim in the same nodelet manager.
+  auto steering = boost::make_shared<std_msgs::Float64>();
+  steering->data = command.steering_torque;
+  steering_publisher_.publish(steering);
+  auto drive = boost::make_shared<std_msgs::Float64>();
+  drive->data = command.drive_torque;
+  drive_publisher_.publish(drive);
 }
 
 }  // namespace birkhoff_cart

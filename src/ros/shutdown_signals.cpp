@@ -1,11 +1,16 @@
 // SIGINT/SIGTERM as a shutdown request (see shutdown_signals.h).
 #include "birkhoff_cart/ros/shutdown_signals.h"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <csignal>
+#include <chrono>
 #include <cstdio>
+#include <fstream>
+#include <string>
+#include <thread>
 
 namespace birkhoff_cart {
 namespace {
@@ -30,5 +35,17 @@ void install_shutdown_signal_handlers() {
 }
 
 bool shutdown_signal_received() { return g_shutdown_signals.load() > 0; }
+
+void end_parent_launch(bool wait) {
+  const pid_t parent = ::getppid();
+  std::string name;
+  std::ifstream("/proc/" + std::to_string(parent) + "/comm") >> name;
+  if (name != "roslaunch") return;
+  ::kill(parent, SIGINT);
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (wait && !shutdown_signal_received() && std::chrono::steady_clock::now() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
 
 }  // namespace birkhoff_cart

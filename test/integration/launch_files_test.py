@@ -44,9 +44,11 @@ class LaunchFiles(unittest.TestCase):
                 missing = [name for name in PINNED if node + name not in parameters]
                 self.assertEqual(missing, [], "%s leaves %s to whatever the master holds for %s" %
                                  (os.path.basename(launch), ", ".join("~" + m for m in missing), node + "*"))
-                self.assertIs(parameters[node + "lockstep"], False, "%s %s" % (launch, node))
+                # Only lockstep.launch runs its loop in lockstep.
+                lockstep = os.path.basename(launch) == "lockstep.launch"
+                self.assertIs(parameters[node + "lockstep"], lockstep, "%s %s" % (launch, node))
                 checked += 1
-        self.assertGreaterEqual(checked, 5)  # sim, cmd_vel, driven, paper, two carts (x2)
+        self.assertGreaterEqual(checked, 6)  # sim, cmd_vel, driven, lockstep, paper, two carts (x2)
 
     def test_default_bags_go_under_ros_home(self):
         sim = dumped_parameters(os.path.join(self.launch_directory, "sim.launch"), self.ros_home)

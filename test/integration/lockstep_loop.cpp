@@ -35,6 +35,9 @@ using birkhoff_cart_test::start_cart_sim;
 using birkhoff_cart_test::start_program;
 using birkhoff_cart_test::wait_exit;
 
+/// nodelet's executable (Debian's libnodeletlib-tools).
+constexpr const char* kNodeletExecutable = "/usr/lib/nodelet/nodelet";
+
 std::string scratch(const std::string& name) { return "/tmp/lockstep_loop_" + std::to_string(::getpid()) + "_" + name; }
 
 struct LoopRun {
@@ -65,6 +68,48 @@ LoopRun run_loop(const std::string& label) {
   run.summary = read_file(summary_path);
   run.log = read_file(sim_log) + read_file(controller_log);
   for (const std::string& path : {summary_path, controller_log, sim_log}) std::remove(path.c_str());
+  ros::NodeHandle().deleteParam("/lockstep_sim");
+  ros::NodeHandle().deleteParam("/pd_" + label);
+  return run;
+}
+
+/// The same loop as nodelets in one manager (docs/ros_interface.md, "Nodelets"): cart_sim and
+/// steering_pd_controller exchange shared messages without serialization.
+LoopRun run_nodelet_loop(const std::string& label) {
+  std::string scene;
+  ros::NodeHandle("~").getParam("scene", scene);
+  LoopRun run;
+  run.bag = scratch(label + ".bag");
+  const std::string summary_path = scratch(label + "_summary.txt");
+  const std::string manager_log = scratch(label + "_manager.log");
+  const std::string manager = "loop_manager_" + label;
+  ros::NodeHandle parameters("/lockstep_sim");
+  parameters.setParam("scene", scene);
+  parameters.setParam("fast", true);
+  parameters.setParam("lockstep", true);
+  parameters.setParam("duration", kDuration);
+  parameters.setParam("publish_rate", kPublishRate);
+  parameters.setParam("bag_path", run.bag);
+  parameters.setParam("record_wall_time", false);
+  parameters.setParam("summary_path", summary_path);
+  const pid_t manager_pid = start_program(kNodeletExecutable, {"manager", "__name:=" + manager}, manager_log);
+  const pid_t controller = start_program(kNodeletExecutable, {"load", "birkhoff_cart/SteeringPdController", manager,
+                                                              "__name:=pd_" + label});
+  const pid_t simulator = start_program(kNodeletExecutable, {"load", "birkhoff_cart/CartSim", manager,
+                                                             "__name:=lockstep_sim"});
+  // The run ends inside the manager: its summary file appears after the bag is closed.
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(kWaitTimeout);
+  while (ros::WallTime::now() < deadline && read_file(summary_path).find("Lockstep timeouts") == std::string::npos) {
+    ros::WallDuration(0.05).sleep();
+  }
+  run.summary = read_file(summary_path);
+  run.status = run.summary.empty() ? -1 : 0;
+  for (const pid_t pid : {simulator, controller, manager_pid}) {
+    ::kill(pid, SIGINT);
+    wait_exit(pid, 10.0);
+  }
+  run.log = read_file(manager_log);
+  for (const std::string& path : {summary_path, manager_log}) std::remove(path.c_str());
   ros::NodeHandle().deleteParam("/lockstep_sim");
   ros::NodeHandle().deleteParam("/pd_" + label);
   return run;
@@ -113,6 +158,30 @@ TEST(LockstepLoop, TwoRunsRecordIdenticalBags) {
               factor_at == std::string::npos ? "no summary" : first.summary.substr(factor_at, 40).c_str());
   std::remove(first.bag.c_str());
   std::remove(second.bag.c_str());
+}
+
+TEST(LockstepLoop, NodeletLoopsRecordTheSeparateNodesBag) {
+  const LoopRun nodes = run_loop("nodes");
+  const LoopRun first = run_nodelet_loop("nodelets_first");
+  const LoopRun second = run_nodelet_loop("nodelets_second");
+  ASSERT_EQ(nodes.status, 0) << nodes.log;
+  ASSERT_EQ(first.status, 0) << first.log;
+  ASSERT_EQ(second.status, 0) << second.log;
+  ASSERT_TRUE(file_exists(first.bag)) << first.log;
+  const std::string node_bytes = read_file(nodes.bag);
+  const std::string first_bytes = read_file(first.bag);
+  const std::string second_bytes = read_file(second.bag);
+  EXPECT_GT(first_bytes.size(), 0u);
+  EXPECT_TRUE(first_bytes == second_bytes) << "two nodelet loops recorded different bags";
+  EXPECT_TRUE(first_bytes == node_bytes) << "the nodelet loop's bag differs from the separate nodes' ("
+                                         << first_bytes.size() << " and " << node_bytes.size() << " bytes)";
+  EXPECT_NE(first.summary.find("Lockstep timeouts: 0."), std::string::npos) << first.summary;
+  const std::size_t nodelet_factor = first.summary.find("real-time factor ");
+  const std::size_t node_factor = nodes.summary.find("real-time factor ");
+  std::printf("[ measured ] lockstep loop, %g s at %g Hz: separate nodes %s; nodelets %s\n", kDuration, kPublishRate,
+              node_factor == std::string::npos ? "no summary" : nodes.summary.substr(node_factor, 40).c_str(),
+              nodelet_factor == std::string::npos ? "no summary" : first.summary.substr(nodelet_factor, 40).c_str());
+  for (const LoopRun* run : {&nodes, &first, &second}) std::remove(run->bag.c_str());
 }
 
 }  // namespace

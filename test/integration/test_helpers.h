@@ -55,13 +55,13 @@ inline std::string package_executable(const std::string& name) {
 
 inline std::string cart_sim_executable() { return package_executable("cart_sim"); }
 
-/// Starts the package's executable `name` as a child process (fork + execv) with `arguments` (ROS
+/// Starts the package's executable `name` (or the executable at `name` when it is an absolute path) as a child process (fork + execv) with `arguments` (ROS
 /// remappings and _private:=value parameters). With a non-empty `log` its stdout and stderr go to
 /// that file; otherwise they stay the test's. Returns the child's pid (≤ 0 when fork failed); a
 /// child that cannot exec exits 127.
 inline pid_t start_program(const std::string& name, const std::vector<std::string>& arguments,
                            const std::string& log = "") {
-  const std::string executable = package_executable(name);
+  const std::string executable = !name.empty() && name.front() == '/' ? name : package_executable(name);
   std::vector<std::string> storage = {executable};
   storage.insert(storage.end(), arguments.begin(), arguments.end());
   const pid_t pid = ::fork();

@@ -79,6 +79,8 @@ class CartSimNode {
 
   /// The time loop; returns one of the exit codes after closing the bag and printing the summary.
   int run();
+  /// Asks run() to end as at a shutdown signal (thread-safe): the nodelet's unload.
+  void request_stop() { stop_flag_ = true; }
 
   const Simulation& simulation() const { return *simulation_; }
   const CartSimParameters& parameters() const { return parameters_; }
@@ -214,6 +216,7 @@ class CartSimNode {
   std::uint64_t next_diagnostic_index_ = 1;
   bool clock_started_ = false;            ///< the first /clock (t0 + h) went out
   std::atomic<bool> paused_{false};  ///< read by the ~step thread
+  std::atomic<bool> stop_flag_{false};  ///< request_stop()
   std::uint64_t resets_ = 0;              ///< ~reset calls served
   ros::Time last_transform_stamp_;        ///< never the same tf stamp twice
   std::optional<std::string> step_failure_;

@@ -38,8 +38,9 @@ CmdVelControllerSettings load_cmd_vel_controller_settings(const ros::NodeHandle&
 
 class CmdVelControllerNode {
  public:
-  /// Throws std::invalid_argument for a bad parameter.
-  CmdVelControllerNode(ros::NodeHandle node, ros::NodeHandle private_node);
+  /// Throws std::invalid_argument for a bad parameter. `shut_down_on_refusal`: a refusal shuts roscpp
+  /// down (the node's process ends); false for a nodelet, which then only stops its own subscriptions.
+  CmdVelControllerNode(ros::NodeHandle node, ros::NodeHandle private_node, bool shut_down_on_refusal = true);
 
   /// How long joint_states may come without ~steering_joint before the controller refuses to run
   /// [s of wall time]: a wrong joint name is a configuration error, as at a peer controller's load.
@@ -60,6 +61,7 @@ class CmdVelControllerNode {
 
   ros::NodeHandle node_;
   ros::NodeHandle private_node_;
+  bool shut_down_on_refusal_;
   CmdVelController controller_;
   std::string steering_joint_;  ///< ~steering_joint: the hinge's name in joint_states
 

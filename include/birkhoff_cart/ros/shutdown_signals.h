@@ -17,4 +17,11 @@ void install_shutdown_signal_handlers();
 /// True once SIGINT/SIGTERM arrived.
 bool shutdown_signal_received();
 
+/// ~end_launch (docs/ros_interface.md): a roslaunch that started this process with required="true"
+/// prints a red "REQUIRED process has died!" block whenever it ends, also after a clean finish. This
+/// asks the parent roslaunch, if the parent is one, to shut down (SIGINT); with `wait` it then waits
+/// (at most 5 s) for roslaunch's own SIGINT, so that the process exits while roslaunch is already
+/// shutting down. The cart_sim node waits; the nodelet (whose manager roslaunch stops) does not.
+void end_parent_launch(bool wait);
+
 }  // namespace birkhoff_cart

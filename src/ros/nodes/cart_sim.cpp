@@ -1,14 +1,9 @@
 // cart_sim: the simulator node (docs/ros_interface.md, "ROS interface"). All the work is in CartSimNode.
 // Exit codes: 0 finished or interrupted, 1 step failure, 2 refused at start, 3 record failure,
 // 4 unexpected error (bag closed), 130 a second SIGINT/SIGTERM (bag left as <path>.active).
-#include <signal.h>
-#include <unistd.h>
 
-#include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <ros/ros.h>
@@ -16,24 +11,9 @@
 #include "birkhoff_cart/core/version.h"
 #include "birkhoff_cart/ros/cart_sim_node.h"
 #include "birkhoff_cart/ros/node_main.h"
+#include "birkhoff_cart/ros/shutdown_signals.h"
 
 namespace {
-
-// ~end_launch (docs/ros_interface.md): a roslaunch that started this node with required="true" prints a red
-// "REQUIRED process has died!" block whenever the node ends, also after a clean finish. With
-// ~end_launch the node asks its parent roslaunch to shut down (SIGINT) and waits for roslaunch's
-// own SIGINT before it exits, so roslaunch is already shutting down and prints no error.
-void end_parent_launch() {
-  const pid_t parent = ::getppid();
-  std::string name;
-  std::ifstream("/proc/" + std::to_string(parent) + "/comm") >> name;
-  if (name != "roslaunch") return;
-  ::kill(parent, SIGINT);
-  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(5);
-  while (!birkhoff_cart::shutdown_signal_received() && std::chrono::steady_clock::now() < give_up) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-}
 
 int run_node(ros::NodeHandle& node_handle) {
   try {
@@ -73,7 +53,7 @@ int main(int argc, char** argv) {
     ros::param::get("~end_launch", end_launch);
     if (end_launch && exit_code == birkhoff_cart::CartSimNode::kExitFinished &&
         !birkhoff_cart::shutdown_signal_received()) {
-      end_parent_launch();
+      birkhoff_cart::end_parent_launch(true);
     }
     return exit_code;
   });
