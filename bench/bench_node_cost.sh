@@ -3,8 +3,8 @@
 # (the cheapest Birkhoffian 1 kHz stepping; the scene itself now defaults to birkhoff_gauss4 at 10 ms,
 # 100 Hz publishing, its dopri5 shadow reference on) in fast mode for 300 s of scene time, with and
 # without the bag, beside cart_simulate on the same scene and duration (the bare core with CSV at
-# 100 Hz), three times each; then lockstep with steering_pd_controller (driven.yaml, 60 s at 50 Hz),
-# as two processes and as nodelets in one manager, and real-time mode at 1 kHz (CPU share of one core over 15 s of wall time). Also the default
+# 100 Hz), three times each; then lockstep with steering_pd_controller (driven.yaml, 60 s at 50 Hz;
+# then 600 s without a bag, as two processes and as nodelets in one manager), and real-time mode at 1 kHz (CPU share of one core over 15 s of wall time). Also the default
 # scene as shipped (birkhoff_gauss4 at h = 10 ms) with and without the bag beside cart_simulate,
 # and the bag uncompressed (~bag_compression none) once.
 # Ratios: scene time / wall time (the node's from its own summary: its time loop), and CPU time
@@ -109,21 +109,50 @@ kill -INT "$controller_pid" 2>/dev/null || true
 wait "$controller_pid" 2>/dev/null || true
 echo "lockstep (driven.yaml, 60 s at 50 Hz with steering_pd_controller): $(grep -o 'real-time factor [0-9.e+]*' "$work/lockstep.summary") of the loop; $(grep -o 'Lockstep timeouts: [0-9]*' "$work/lockstep.summary"); process wall/user/sys $(cat "$work/lockstep.time")"
 
-# The same loop as nodelets in one manager (zero-copy messages): the summary appears when the run ends.
-rosparam delete /cart_sim > /dev/null 2>&1 || true
-/usr/lib/nodelet/nodelet manager __name:=loop_manager > "$work/manager.log" 2>&1 &
-manager_pid=$!
-/usr/lib/nodelet/nodelet load birkhoff_cart/SteeringPdController loop_manager __name:=pd > "$work/pd_nodelet.log" 2>&1 &
-pd_loader=$!
-/usr/lib/nodelet/nodelet load birkhoff_cart/CartSim loop_manager __name:=cart_sim _scene:="$repo/config/scenes/driven.yaml" \
-  _fast:=true _lockstep:=true _publish_rate:=50 _duration:=60 _summary_path:="$work/nodelet.summary" > "$work/nodelet.log" 2>&1 &
-sim_loader=$!
-for _ in $(seq 1200); do grep -q 'Lockstep timeouts' "$work/nodelet.summary" 2>/dev/null && break; sleep 0.1; done
-kill -INT "$sim_loader" "$pd_loader" 2>/dev/null || true
-wait "$sim_loader" "$pd_loader" 2>/dev/null || true
-kill -INT "$manager_pid" 2>/dev/null || true
-wait "$manager_pid" 2>/dev/null || true
-echo "lockstep as nodelets in one manager (same loop): $(grep -o 'real-time factor [0-9.e+]*' "$work/nodelet.summary") of the loop; $(grep -o 'Lockstep timeouts: [0-9]*' "$work/nodelet.summary")"
+# The same loop as nodelets in one manager (zero-copy messages, the controller answering inside
+# cart_sim's publish), 600 s of scene time, with driven.yaml's integrator (birkhoff2 at 1 ms) and with
+# birkhoff_gauss4 at 10 ms, beside the separate nodes with the same settings. The nodelet run ends
+# inside the manager: its summary appears when the run is over.
+nodelet_loop() {  # label, extra cart_sim arguments
+  local label="$1"; shift
+  rosparam delete /cart_sim > /dev/null 2>&1 || true
+  /usr/lib/nodelet/nodelet manager __name:=loop_manager > "$work/manager_$label.log" 2>&1 &
+  local manager_pid=$!
+  /usr/lib/nodelet/nodelet load birkhoff_cart/SteeringPdController loop_manager __name:=pd > "$work/pd_$label.log" 2>&1 &
+  local pd_loader=$!
+  /usr/lib/nodelet/nodelet load birkhoff_cart/CartSim loop_manager __name:=cart_sim _scene:="$repo/config/scenes/driven.yaml" \
+    _fast:=true _lockstep:=true _publish_rate:=50 _duration:=600 _bag_path:= _summary_path:="$work/$label.summary" "$@" \
+    > "$work/$label.log" 2>&1 &
+  local sim_loader=$!
+  for _ in $(seq 3000); do grep -q 'Lockstep timeouts' "$work/$label.summary" 2>/dev/null && break; sleep 0.1; done
+  kill -INT "$sim_loader" "$pd_loader" 2>/dev/null || true
+  wait "$sim_loader" "$pd_loader" 2>/dev/null || true
+  kill -INT "$manager_pid" 2>/dev/null || true
+  wait "$manager_pid" 2>/dev/null || true
+  echo "  nodelets in one manager: $(grep -o 'real-time factor [0-9.e+]*' "$work/$label.summary"); $(grep -o 'stepping [0-9.e+-]* s' "$work/$label.summary") of $(grep -o 'wall time [0-9.e+-]* s' "$work/$label.summary"); $(grep -o 'Lockstep timeouts: [0-9]*' "$work/$label.summary")"
+}
+node_loop() {  # label, extra cart_sim arguments
+  local label="$1"; shift
+  rosparam delete /cart_sim > /dev/null 2>&1 || true
+  "$bin/steering_pd_controller" __name:=pd > "$work/pd_$label.log" 2>&1 &
+  local controller_pid=$!
+  "$bin/cart_sim" __name:=cart_sim _scene:="$repo/config/scenes/driven.yaml" _fast:=true _lockstep:=true _publish_rate:=50 \
+    _duration:=600 _bag_path:= _summary_path:="$work/$label.summary" "$@" > "$work/$label.log" 2>&1 || true
+  kill -INT "$controller_pid" 2>/dev/null || true
+  wait "$controller_pid" 2>/dev/null || true
+  echo "  two node processes:      $(grep -o 'real-time factor [0-9.e+]*' "$work/$label.summary"); $(grep -o 'stepping [0-9.e+-]* s' "$work/$label.summary") of $(grep -o 'wall time [0-9.e+-]* s' "$work/$label.summary"); $(grep -o 'Lockstep timeouts: [0-9]*' "$work/$label.summary")"
+}
+# Wall-clock ROS time: a lockstep loop needs no /clock listener (stamps are scene time), and under
+# /use_sim_time the nodelet manager would hear every /clock cart_sim publishes (roscpp's own
+# subscription, which the cart_sim executable remaps away).
+rosparam set /use_sim_time false
+echo "lockstep loop, driven.yaml, 600 s at 50 Hz, no bag, /use_sim_time false, birkhoff2 at h = 1 ms (the scene's):"
+node_loop loop_nodes_b2
+nodelet_loop loop_nodelets_b2
+echo "lockstep loop, driven.yaml, 600 s at 50 Hz, no bag, /use_sim_time false, birkhoff_gauss4 at h = 10 ms:"
+node_loop loop_nodes_g4 _integrator:=birkhoff_gauss4 _step_size:=0.01
+nodelet_loop loop_nodelets_g4 _integrator:=birkhoff_gauss4 _step_size:=0.01
+rosparam set /use_sim_time true
 
 # Real time at 1 kHz: CPU share of one core over 15 s after a 3 s start-up.
 rosparam delete /cart_sim > /dev/null 2>&1 || true

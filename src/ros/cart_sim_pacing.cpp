@@ -2,6 +2,8 @@
 // deadlines of real-time mode, pauses and the lockstep barrier.
 #include "birkhoff_cart/ros/cart_sim_node.h"
 
+#include <thread>
+
 #include <algorithm>
 #include <chrono>
 
@@ -13,6 +15,8 @@ using Clock = WallClockPacing::Clock;
 // Longest single sleep [s]: a SIGINT/SIGTERM (whose handler cannot wake a condition) is seen
 // within this time.
 constexpr double kLongestSleep = 0.1;
+/// How long a lockstep barrier polls for the controllers' answers before it sleeps [µs].
+constexpr int kLockstepSpinMicroseconds = 200;
 
 Clock::time_point after(double seconds) {
   return Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
@@ -84,6 +88,10 @@ void CartSimNode::wait_for_commands(double time) {
                static_cast<unsigned long>(lockstep_timeouts_));
       break;
     }
+    // A controller in the same process (a nodelet) answers within microseconds: poll for it a
+    // little before sleeping, since a sleep and its wake-up cost more than the answer takes.
+    const Clock::time_point spin_until = now + std::chrono::microseconds(kLockstepSpinMicroseconds);
+    while (!callback_queue_.pending() && Clock::now() < spin_until) std::this_thread::yield();
     callback_queue_.wait_until(std::min(give_up, now + std::chrono::duration_cast<Clock::duration>(
                                                            std::chrono::duration<double>(kLongestSleep))));
     process_callbacks();

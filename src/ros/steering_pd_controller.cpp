@@ -11,7 +11,7 @@
 
 namespace birkhoff_cart {
 
-SteeringPdController::SteeringPdController(ros::NodeHandle node, ros::NodeHandle private_node)
+SteeringPdController::SteeringPdController(ros::NodeHandle node, ros::NodeHandle private_node, bool inline_answers)
     : kp_(private_node.param("kp", 40.0)),
       kd_(private_node.param("kd", 4.0)),
       amplitude_(private_node.param("amplitude", 0.3)),
@@ -23,8 +23,10 @@ SteeringPdController::SteeringPdController(ros::NodeHandle node, ros::NodeHandle
   }
   steering_publisher_ = node.advertise<std_msgs::Float64>("steering_torque", 100);
   drive_publisher_ = node.advertise<std_msgs::Float64>("drive_torque", 100);
-  subscriber_ = node.subscribe<sensor_msgs::JointState>("joint_states", 100, &SteeringPdController::on_joint_states,
-                                                         this, ros::TransportHints().tcpNoDelay());
+  ros::NodeHandle subscribing = node;
+  if (inline_answers) subscribing.setCallbackQueue(&inline_queue_);
+  subscriber_ = subscribing.subscribe<sensor_msgs::JointState>(
+      "joint_states", 100, &SteeringPdController::on_joint_states, this, ros::TransportHints().tcpNoDelay());
   ROS_INFO("steering_pd_controller: chi_ref = %g sin(2 pi %g t) rad, kp = %g N m/rad, kd = %g N m s/rad, drive %g N m",
            amplitude_, frequency_, kp_, kd_, drive_torque_);
 }

@@ -11,13 +11,16 @@
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 
+#include "birkhoff_cart/ros/inline_callback_queue.h"
+
 namespace birkhoff_cart {
 
 class SteeringPdController {
  public:
   /// Reads ~kp, ~kd, ~amplitude, ~frequency, ~drive_torque; throws std::invalid_argument naming them
-  /// when one is not finite.
-  SteeringPdController(ros::NodeHandle node, ros::NodeHandle private_node);
+  /// when one is not finite. With `inline_answers` joint_states is handled in the publisher's thread
+  /// (InlineCallbackQueue: the nodelet in cart_sim's manager), otherwise on `node`'s queue.
+  SteeringPdController(ros::NodeHandle node, ros::NodeHandle private_node, bool inline_answers = false);
 
  private:
   void on_joint_states(const sensor_msgs::JointState::ConstPtr& joints);
@@ -27,6 +30,7 @@ class SteeringPdController {
   double amplitude_;     ///< χ_ref amplitude [rad]
   double frequency_;     ///< χ_ref frequency [Hz]
   double drive_torque_;  ///< [N·m]
+  InlineCallbackQueue inline_queue_;  ///< with inline_answers: joint_states served in the publisher's thread
   ros::Publisher steering_publisher_;
   ros::Publisher drive_publisher_;
   ros::Subscriber subscriber_;

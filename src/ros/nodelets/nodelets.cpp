@@ -61,12 +61,15 @@ class CmdVelControllerNodelet : public nodelet::Nodelet {
   std::unique_ptr<CmdVelControllerNode> node_;
 };
 
-/// steering_pd_controller as a nodelet.
+/// steering_pd_controller as a nodelet. With ~inline_answers (default true) it answers each
+/// joint_states inside the publisher's publish(): in cart_sim's manager the lockstep barrier then
+/// finds both torques queued and no thread is woken.
 class SteeringPdControllerNodelet : public nodelet::Nodelet {
  private:
   void onInit() override {
     try {
-      controller_ = std::make_unique<SteeringPdController>(getNodeHandle(), getPrivateNodeHandle());
+      const bool inline_answers = getPrivateNodeHandle().param("inline_answers", true);
+      controller_ = std::make_unique<SteeringPdController>(getNodeHandle(), getPrivateNodeHandle(), inline_answers);
     } catch (const std::invalid_argument& error) {
       NODELET_FATAL("steering_pd_controller: %s", error.what());
     }
