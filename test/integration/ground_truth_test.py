@@ -90,6 +90,15 @@ class GroundTruth(unittest.TestCase):
             self.assertEqual(transform.transform.rotation.w, 1.0)
             self.assertEqual(transform.transform.translation.x, 0.0)
 
+    def test_1b_publish_world_tf_false_leaves_map_to_odom_to_the_user(self):
+        rospy.wait_for_service("/local/cart_sim/pause", timeout=30.0)  # the fourth cart is up
+        self.wait_for(lambda: any(t.child_frame_id == "noisy/odom" for t in self.static_transforms), 10.0)
+        time.sleep(1.0)  # a latched /tf_static of the fourth cart would have arrived by now
+        with self.lock:
+            children = [t.child_frame_id for t in self.static_transforms]
+        self.assertNotIn("local/odom", children, "~publish_world_tf false still published map -> odom")
+        self.assertIn("noisy/odom", children)
+
     def test_2_sensor_on_ground_truth_is_the_noise_free_run_bit_for_bit(self):
         for truth, exact in zip(self.series("noisy", "ground_truth"), self.series("exact", "odom")):
             self.assertEqual(key_of(truth), key_of(exact), f"t = {truth.header.stamp.to_sec()} s")
