@@ -76,11 +76,15 @@ bool CartSimNode::on_set_state(SetCartState::Request& request, SetCartState::Res
 }
 
 void CartSimNode::on_initial_pose(const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& message) {
+  // The odom frame, or the world frame while map -> odom is cart_sim's identity (~publish_world_tf):
+  // the same coordinates. With a localizer of the user's owning map -> odom, only odom.
   const std::string& frame = message->header.frame_id;
-  if (!frame.empty() && frame != parameters_.frames.odom) {
-    ROS_ERROR("cart_sim: %s refused: the pose is in frame '%s', cart_sim places the cart in '%s' (set rviz's "
+  const bool world_is_odom = parameters_.publish_world_tf && frame == parameters_.frames.world;
+  if (!frame.empty() && frame != parameters_.frames.odom && !world_is_odom) {
+    ROS_ERROR("cart_sim: %s refused: the pose is in frame '%s', cart_sim places the cart in '%s'%s (set rviz's "
               "fixed frame to it); the simulation goes on unchanged",
-              initial_pose_subscriber_.getTopic().c_str(), frame.c_str(), parameters_.frames.odom.c_str());
+              initial_pose_subscriber_.getTopic().c_str(), frame.c_str(), parameters_.frames.odom.c_str(),
+              parameters_.publish_world_tf ? (" or '" + parameters_.frames.world + "'").c_str() : "");
     return;
   }
   const geometry_msgs::Pose& pose = message->pose.pose;

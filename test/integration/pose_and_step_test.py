@@ -139,16 +139,22 @@ class PoseAndStep(unittest.TestCase):
         self.initial_pose.publish(message)
         time.sleep(0.3)  # the paused node runs the callback while it waits
 
-    def test_4_initial_pose_from_rviz_teleports_in_the_odom_frame_only(self):
+    def test_4_initial_pose_from_rviz_teleports_in_the_odom_or_map_frame_only(self):
         self.send_initial_pose("odom", -3.0, 1.0, 1.0)
         odom, _ = self.stepped_odom_after(5)
         pose = odom.pose.pose
         self.assertAlmostEqual(pose.position.x, -3.0, delta=TELEPORT_TOLERANCE)
         self.assertAlmostEqual(pose.position.y, 1.0, delta=TELEPORT_TOLERANCE)
         self.assertAlmostEqual(yaw_of(pose), 1.0, delta=TELEPORT_TOLERANCE)
-        self.send_initial_pose("map", 40.0, 40.0, 0.0)  # not cart_sim's frame: refused
+        self.send_initial_pose("base_link", 40.0, 40.0, 0.0)  # not a frame cart_sim places the cart in: refused
         after, _ = self.stepped_odom_after(5)
         self.assertAlmostEqual(after.pose.pose.position.x, -3.0, delta=2 * TELEPORT_TOLERANCE)
+        # map, rviz's default fixed frame: the same coordinates while map -> odom is cart_sim's identity.
+        self.send_initial_pose("map", 7.0, -2.0, -0.5)
+        placed, _ = self.stepped_odom_after(5)
+        self.assertAlmostEqual(placed.pose.pose.position.x, 7.0, delta=TELEPORT_TOLERANCE)
+        self.assertAlmostEqual(placed.pose.pose.position.y, -2.0, delta=TELEPORT_TOLERANCE)
+        self.assertAlmostEqual(yaw_of(placed.pose.pose), -0.5, delta=TELEPORT_TOLERANCE)
 
     def test_5_the_bag_goes_on_across_teleports_and_step_runs_out_at_the_end(self):
         bag_path = rospy.get_param("/stepped/cart_sim/bag_path")
