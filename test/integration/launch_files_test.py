@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """rostest launch_files: each shipped launch file that starts cart_sim sets PINNED on every
 cart_sim it starts (roslaunch --dump-params), and the default bag paths of sim.launch and
-paper.launch lie under $ROS_HOME when it is set."""
+paper.launch lie under $ROS_HOME when it is set; lockstep.launch runs its loop as nodelets and as
+nodes and ends with the run."""
 import glob
 import os
 import subprocess
@@ -58,6 +59,23 @@ class LaunchFiles(unittest.TestCase):
         self.assertTrue(paths)
         for path in paths:
             self.assertTrue(path.startswith(self.ros_home + "/paper_"), path)
+
+    def test_lockstep_launch_runs_the_loop_and_ends_with_it(self):
+        # Both ways: nodelets in one manager (cart_sim's ~end_launch from inside the manager) and two
+        # node processes; each ends by itself with every instant answered.
+        for nodelets in ("true", "false"):
+            summary = "/tmp/birkhoff_cart_lockstep_%d_%s.summary" % (os.getpid(), nodelets)
+            result = subprocess.run(["roslaunch", PACKAGE, "lockstep.launch", "nodelets:=" + nodelets, "duration:=2",
+                                     "summary_path:=" + summary], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                    universal_newlines=True, timeout=60, stdin=subprocess.DEVNULL)
+            self.assertEqual(result.returncode, 0, result.stdout[-3000:])
+            self.assertNotIn("REQUIRED process", result.stdout)
+            with open(summary) as file:
+                text = file.read()
+            os.remove(summary)
+            self.assertIn("final t = 2 s", text)
+            self.assertIn("Lockstep timeouts: 0.", text)
+            self.assertIn("Published instants: 100.", text)
 
 
 if __name__ == "__main__":
