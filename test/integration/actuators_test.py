@@ -1,6 +1,6 @@
 #!/usr/bin/python3
-"""rostest actuators: cart_sim on a scene with a steering motor (T = 0.2 s, d = 0.05 s, 2 N·m
-saturation), a drive motor (T = 0.3 s, 4 N·m saturation) and end stops at ±0.5 rad
+"""rostest actuators: cart_sim on a scene with a steering motor (T = 0.2 s, d = 0.05 s, 5 N·m/s rate
+limit, 2 N·m saturation), a drive motor (T = 0.3 s, 4 N·m saturation) and end stops at ±0.5 rad
 (test/integration/actuators_scene.yaml, docs/actuators.md). Paused at t = 0, commanded 3 N·m steering
 and 10 N·m drive, then advanced 3000 steps (3 s) with ~step."""
 import math
@@ -21,8 +21,13 @@ STOP = 0.5  # [rad]
 
 
 def steering_applied(t):
-    """(A1), (A5), (A2): 3 N·m saturated to 2, 50 ms dead time, 0.2 s lag, from rest at 0 [N·m]."""
-    return 0.0 if t <= 0.05 else 2.0 * (1.0 - math.exp(-(t - 0.05) / 0.2))
+    """(A1), (A5), (A4): 3 N·m saturated to 2, 50 ms dead time, then a 5 N·m/s ramp while the 0.2 s lag
+    would be faster (until |2 − τ| = R T = 1 N·m at t = 0.25 s), then the lag, from rest at 0 [N·m]."""
+    if t <= 0.05:
+        return 0.0
+    if t <= 0.25:
+        return 5.0 * (t - 0.05)
+    return 2.0 - 1.0 * math.exp(-(t - 0.25) / 0.2)
 
 
 def drive_applied(t):
