@@ -205,6 +205,10 @@ Scene read_scene(const SceneReader& reader, const YAML::Node& root, const std::s
   scene.odometry_sensor = scene_detail::read_odometry_sensor(reader, root["odometry_sensor"]);
   scene.actuators = scene_detail::read_actuators(reader, root);
   if (scene.actuators.end_stops) {
+    if (scene.paper_special_case) {
+      reader.fail("steering_end_stops", "cannot go with paper_special_case: its M11 = mu + mu1 sin^2(chi) is 0, so an "
+                                        "impact and the holding reaction (docs/actuators.md (S1), (S2)) are undefined");
+    }
     if (scene.reference.kind == ReferenceSettings::Kind::kPaperAnalytic) {
       reader.fail("steering_end_stops", "cannot go with reference paper_analytic (its closed form has no stops); use "
                                         "shadow_run or none");

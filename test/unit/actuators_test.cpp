@@ -364,6 +364,18 @@ TEST(ActuatorScenes, BadSectionsAreRefusedByName) {
                                         "    profile: cosine\n    amplitude: 1.0\n    frequency: 0.5");
   EXPECT_NE(cosine.find("key 'steering_actuator'"), std::string::npos) << cosine;
   EXPECT_NE(cosine.find("piecewise-constant"), std::string::npos) << cosine;
+  // The paper's special case has M11 = 0: no impact or holding reaction exists.
+  std::ifstream paper_in(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/paper_special.yaml");
+  std::stringstream paper_text;
+  paper_text << paper_in.rdbuf();
+  const std::string paper_path = ::testing::TempDir() + "paper_stops.yaml";
+  std::ofstream(paper_path) << paper_text.str() << "\nsteering_end_stops: {angle: 1.5}\n";
+  try {
+    load_scene(paper_path);
+    ADD_FAILURE() << "end stops accepted on the paper's special case";
+  } catch (const SceneError& error) {
+    EXPECT_NE(std::string(error.what()).find("paper_special_case"), std::string::npos) << error.what();
+  }
   // Stops the initial state already lies beyond.
   const std::string beyond = load_error("steering_end_stops: {angle: 0.3}\n", "  steering_angle: 0.0 ", "  steering_angle: 0.4 ");
   EXPECT_NE(beyond.find("initial_state.steering_angle"), std::string::npos) << beyond;
