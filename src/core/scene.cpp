@@ -204,6 +204,10 @@ Scene read_scene(const SceneReader& reader, const YAML::Node& root, const std::s
   scene.accuracy = scene_detail::read_accuracy(reader, root["accuracy"]);
   scene.odometry_sensor = scene_detail::read_odometry_sensor(reader, root["odometry_sensor"]);
   scene.actuators = scene_detail::read_actuators(reader, root);
+  if (scene.actuators.any() && scene.integrator.step_control == "reversible") {
+    reader.fail("integrator.step_control", "reversible cannot go with steering_actuator, drive_actuator or "
+                                           "steering_end_stops (docs/actuators.md §4); use fixed");
+  }
   if (scene.actuators.end_stops) {
     if (scene.paper_special_case) {
       reader.fail("steering_end_stops", "cannot go with paper_special_case: its M11 = mu + mu1 sin^2(chi) is 0, so an "

@@ -35,7 +35,15 @@ void require_finite_torque(double torque, const char* which) {
 
 /// The scene's integrator settings with the defaults that depend on the scene filled in: the
 /// reversible controller's tolerance horizon is the scene's duration unless the scene names one.
+/// Refuses the reversible control with actuators or end stops: its internal steps run ahead of the
+/// step being committed, while the actuators' state and the end-stop events advance step by step
+/// (docs/actuators.md §4).
 IntegratorSettings integrator_settings(const Scene& scene) {
+  if (scene.actuators.any() && scene.integrator.step_control == "reversible") {
+    throw std::invalid_argument(
+        "integrator.step_control: reversible cannot go with steering_actuator, drive_actuator or steering_end_stops "
+        "(docs/actuators.md); use fixed");
+  }
   IntegratorSettings settings = scene.integrator;
   if (settings.tolerance_horizon == 0.0) settings.tolerance_horizon = scene.duration;
   return settings;

@@ -297,6 +297,20 @@ TEST(EndStops, ABounceReversesTheRateByTheRestitution) {
   EXPECT_LT(std::abs(simulation->diagnostics().energy_balance_residual), 1e-9);
 }
 
+TEST(ActuatedCart, TheReversibleStepControlIsRefusedByName) {
+  Scene scene = driven_scene();
+  scene.integrator.name = "birkhoff_gauss4";
+  scene.integrator.step_control = "reversible";
+  scene.integrator.position_tolerance = 1e-6;
+  scene.actuators.steering = lag(0.1);
+  try {
+    Simulation simulation(scene);
+    ADD_FAILURE() << "the reversible control was accepted with an actuator";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("integrator.step_control"), std::string::npos) << error.what();
+  }
+}
+
 TEST(EndStops, ARestartBeyondTheStopsIsRefused) {
   std::unique_ptr<Simulation> simulation(stopped_cart(0.0, 0.0));
   CartState beyond = simulation->state();
