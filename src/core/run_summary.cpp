@@ -31,6 +31,32 @@ std::string step_control_summary(const IntegratorSettings& settings, const StepS
   return text;
 }
 
+std::string actuator_summary(const Simulation& simulation) {
+  const Simulation::ActuatorStatus status = simulation.actuator_status();
+  std::string text;
+  char part[200];
+  if (status.steering_actuator) {
+    std::snprintf(part, sizeof part, "steering motor applies %.6g N·m (input %.6g N·m)", status.steering_applied,
+                  status.steering_input);
+    text += part;
+  }
+  if (status.drive_actuator) {
+    std::snprintf(part, sizeof part, "%sdrive motor applies %.6g N·m (input %.6g N·m)", text.empty() ? "" : "; ",
+                  status.drive_applied, status.drive_input);
+    text += part;
+  }
+  if (status.end_stops) {
+    const double angle = simulation.scene().actuators.end_stops->angle;  // χ_s [rad]
+    std::snprintf(part, sizeof part, "%send stops at +-%.6g rad: %s, end-stop events %llu", text.empty() ? "" : "; ", angle,
+                  status.end_stop_contact > 0 ? "resting on the upper stop"
+                  : status.end_stop_contact < 0 ? "resting on the lower stop"
+                                                : "free",
+                  static_cast<unsigned long long>(status.end_stop_events));
+    text += part;
+  }
+  return text;
+}
+
 std::string run_summary(const Simulation& simulation, const AccuracyGuard& guard) {
   const StepStatistics& statistics = simulation.statistics();
   const Diagnostics diagnostics = simulation.diagnostics();
@@ -52,6 +78,8 @@ std::string run_summary(const Simulation& simulation, const AccuracyGuard& guard
   text += "  " + local_error_estimate_summary(statistics, simulation.integrator_name()) + "\n";
   const std::string control = step_control_summary(simulation.scene().integrator, statistics);
   if (!control.empty()) text += "  " + control + "\n";
+  const std::string actuators = actuator_summary(simulation);
+  if (!actuators.empty()) text += "  actuators: " + actuators + "\n";
   text += "  accuracy: " + guard.summary() + "\n";
   return text;
 }

@@ -15,6 +15,7 @@
 #include "birkhoff_cart/core/actuators/steering_end_stops.h"
 #include "birkhoff_cart/core/actuators/torque_actuator.h"
 #include "birkhoff_cart/core/cart_model.h"
+#include "birkhoff_cart/core/run_summary.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
 
@@ -340,6 +341,9 @@ TEST(ShippedScene, SteeringActuatorRestsOnItsStopAndAgreesWithItsReference) {
               diagnostics.reference_position_error, diagnostics.energy_balance_residual);
   EXPECT_LT(diagnostics.reference_position_error, 1e-7);
   EXPECT_LT(std::abs(diagnostics.energy_balance_residual), 1e-9);
+  EXPECT_EQ(actuator_summary(simulation),
+            "steering motor applies 2 N·m (input 3 N·m); drive motor applies 4 N·m (input 6 N·m); end stops at "
+            "+-0.6 rad: resting on the upper stop, end-stop events 1");
 }
 
 /// `driven.yaml` with `extra` appended (and `replace` → `with` applied), loaded from a temp file; the

@@ -16,6 +16,10 @@ std::string local_error_estimate_summary(const StepStatistics& statistics, const
 /// step_control "fixed".
 std::string step_control_summary(const IntegratorSettings& settings, const StepStatistics& statistics);
 
+/// One line on the actuators and end stops (docs/actuators.md): applied torques and inputs, the
+/// contact and the number of events; empty when the scene has none.
+std::string actuator_summary(const Simulation& simulation);
+
 /// Several lines, each ending in '\n', each starting with two spaces except the first.
 std::string run_summary(const Simulation& simulation, const AccuracyGuard& guard);
 
