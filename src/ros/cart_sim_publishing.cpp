@@ -38,7 +38,10 @@ void CartSimNode::publish_instant() {
   period_steps_ = 0;
   InstantMessages& messages = *instant_messages_;
   const OdometryEstimate* estimate = odometry_sensor_ ? &odometry_sensor_->read(simulation_->state()) : nullptr;
-  messages.fill(*simulation_, accuracy_guard_, last_wall_time_per_step_, estimate);
+  // The accuracy guard is judged here, once per instant, before the messages are filled from it.
+  const Diagnostics diagnostics = simulation_->diagnostics();
+  accuracy_guard_.check(simulation_->state().time, diagnostics, simulation_->statistics());
+  messages.fill(*simulation_, diagnostics, accuracy_guard_, last_wall_time_per_step_, estimate);
 
   // The controllers' inputs as shared messages (zero-copy in a nodelet manager).
   publish_shared(ground_truth_publisher_, messages.ground_truth);

@@ -18,8 +18,8 @@ InstantMessages::InstantMessages(ros_conversions::FrameNames frames, ros_convers
   transforms.transforms.resize(1);
 }
 
-void InstantMessages::fill(const Simulation& simulation, AccuracyGuard& guard, double wall_time_per_step,
-                           const OdometryEstimate* estimate) {
+void InstantMessages::fill(const Simulation& simulation, const Diagnostics& diagnostics, const AccuracyGuard& guard,
+                           double wall_time_per_step, const OdometryEstimate* estimate) {
   const CartState& state = simulation.state();
   const CartModel& model = simulation.model();
   ros_conversions::fill_odometry(ground_truth, state, model, ground_truth_frames_, kExactCovariance);
@@ -32,8 +32,6 @@ void InstantMessages::fill(const Simulation& simulation, AccuracyGuard& guard, d
   }
   ros_conversions::fill_joint_state(joints, state, model, ros_conversions::actuator_efforts(simulation),
                                     frames_.joint_prefix);
-  const Diagnostics diagnostics = simulation.diagnostics();
-  guard.check(state.time, diagnostics, simulation.statistics());
   ros_conversions::fill_integration_error(integration_error, state, diagnostics, simulation.statistics(),
                                           simulation.integrator_name(), simulation.step_size(), wall_time_per_step);
   integration_error.accuracy_level = static_cast<std::uint8_t>(guard.level());

@@ -65,12 +65,21 @@ Scene stepping_scene() {
 // A prefix that puts every frame and joint name beyond the small-string buffer (15 chars).
 ros_conversions::FrameNames prefixed() { return ros_conversions::prefixed_frames(kPrefix, "odom", "base_link"); }
 
-/// One publish instant of the node: steps, fill, the four bag writes.
+/// The node's order at a publish instant: the guard judges the diagnostics, then the messages are
+/// filled from them and from the guard (a fill changes nothing but the messages).
+void check_and_fill(const Simulation& simulation, AccuracyGuard& guard, InstantMessages& messages,
+                    double wall_time_per_step) {
+  const Diagnostics diagnostics = simulation.diagnostics();
+  guard.check(simulation.state().time, diagnostics, simulation.statistics());
+  messages.fill(simulation, diagnostics, guard, wall_time_per_step);
+}
+
+/// One publish instant of the node: steps, guard check and fill, the four bag writes.
 void run_instant(Simulation& simulation, InstantMessages& messages, AccuracyGuard& guard, BagRecorder& recorder,
                  const std::string& odometry_topic, const std::string& joint_state_topic,
                  const std::string& error_topic) {
   for (int k = 0; k < kStepsPerInstant; ++k) simulation.step();
-  messages.fill(simulation, guard, 1e-6);
+  check_and_fill(simulation, guard, messages, 1e-6);
   recorder.write(error_topic, messages.integration_error.header.stamp, messages.integration_error);
   recorder.write(odometry_topic, messages.odometry.header.stamp, messages.odometry);
   recorder.write(joint_state_topic, messages.joints.header.stamp, messages.joints);
@@ -124,9 +133,9 @@ TEST(InstantMessages, FilledMessagesEqualTheConversions) {
   for (int k = 0; k < 137; ++k) simulation.step();
   AccuracyGuard guard(simulation.scene().accuracy);
   InstantMessages messages(prefixed(), ros_conversions::OdometryCovariance{});
-  messages.fill(simulation, guard, 2e-6);
+  check_and_fill(simulation, guard, messages, 2e-6);
   for (int k = 0; k < 50; ++k) simulation.step();
-  messages.fill(simulation, guard, 3e-6);  // a second fill overwrites every field
+  check_and_fill(simulation, guard, messages, 3e-6);  // a second fill overwrites every field
   const CartState& state = simulation.state();
   const nav_msgs::Odometry odometry = ros_conversions::to_odometry(state, simulation.model(), prefixed());
   EXPECT_EQ(messages.odometry, odometry);

@@ -25,12 +25,14 @@ class InstantMessages {
   InstantMessages(ros_conversions::FrameNames frames, ros_conversions::OdometryCovariance covariance);
 
   /// Fills ground_truth, odometry, joints, the odom → base_link transform and integration_error
-  /// from the simulation's current state; checks `guard` with its diagnostics (the accuracy fields of
-  /// integration_error follow it). `wall_time_per_step` [s] goes into integration_error. With an
-  /// odometry sensor's `estimate`, odometry and the transform are the estimate's; without, they are
-  /// the exact state, as ground_truth is.
-  void fill(const Simulation& simulation, AccuracyGuard& guard, double wall_time_per_step,
-            const OdometryEstimate* estimate = nullptr);
+  /// from the simulation's current state and its `diagnostics` (simulation.diagnostics(), computed
+  /// once by the caller); the accuracy fields of integration_error are read from `guard`, which the
+  /// caller has checked with the same diagnostics (a fill changes nothing but the messages).
+  /// `wall_time_per_step` [s] goes into integration_error. With an odometry sensor's `estimate`,
+  /// odometry and the transform are the estimate's; without, they are the exact state, as
+  /// ground_truth is.
+  void fill(const Simulation& simulation, const Diagnostics& diagnostics, const AccuracyGuard& guard,
+            double wall_time_per_step, const OdometryEstimate* estimate = nullptr);
 
   nav_msgs::Odometry ground_truth;  ///< the exact state: base_link in the world frame, covariances 0
   nav_msgs::Odometry odometry;      ///< in odom: the exact state, or the odometry sensor's estimate
