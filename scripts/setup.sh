@@ -19,7 +19,7 @@ packages=(
   libnav-msgs-dev libsensor-msgs-dev libgeometry-msgs-dev
   libdiagnostic-updater-dev libdiagnostic-msgs-dev
   python3-rostest python3-rosbag python3-rostopic python3-roslaunch python3-rosnode
-  python3-rosservice python3-tf2-ros python3-rosgraph-msgs python3-catkin-pkg python3-empy
+  python3-rosservice python3-roswtf python3-tf2-ros python3-rosgraph-msgs python3-catkin-pkg python3-empy
   # the message classes `rostopic echo` needs for odom, joint_states, /diagnostics, /tf, cmd_vel
   python3-std-msgs python3-geometry-msgs python3-nav-msgs python3-sensor-msgs python3-diagnostic-msgs
   python3-tf2-msgs

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <ros/ros.h>
+#include <rosgraph_msgs/Clock.h>
 
 #include "birkhoff_cart/core/version.h"
 #include "birkhoff_cart/ros/cart_sim_node.h"
@@ -48,6 +49,12 @@ int main(int argc, char** argv) {
     // Outlives the node: when the last NodeHandle dies roscpp shuts down and drops later log output,
     // so the FATAL message below would be lost.
     ros::NodeHandle node_handle;
+    // A publisher on the unheard topic that never publishes: the master's graph then shows roscpp's
+    // moved subscription as connected, and roswtf's online checks stay clean.
+    ros::Publisher unheard_clock_holder;
+    if (ros::Time::isSimTime()) {
+      unheard_clock_holder = node_handle.advertise<rosgraph_msgs::Clock>(birkhoff_cart::kUnheardClockTopic, 1);
+    }
     const int exit_code = run_node(node_handle);
     bool end_launch = false;
     ros::param::get("~end_launch", end_launch);
