@@ -9,17 +9,29 @@
 #include <boost/make_shared.hpp>
 #include <std_msgs/Float64.h>
 
+#include "birkhoff_cart/core/closest_name.h"
+#include "birkhoff_cart/ros/parameter_reading.h"
+
 namespace birkhoff_cart {
 
-SteeringPdController::SteeringPdController(ros::NodeHandle node, ros::NodeHandle private_node, bool inline_answers)
-    : kp_(private_node.param("kp", 40.0)),
-      kd_(private_node.param("kd", 4.0)),
-      amplitude_(private_node.param("amplitude", 0.3)),
-      frequency_(private_node.param("frequency", 0.25)),
-      drive_torque_(private_node.param("drive_torque", 5.0)) {
+SteeringPdController::SteeringPdController(ros::NodeHandle node, ros::NodeHandle private_node, bool inline_answers,
+                                           bool shut_down_on_refusal)
+    : kp_(read_double_parameter(private_node, "kp", 40.0)),
+      kd_(read_double_parameter(private_node, "kd", 4.0)),
+      amplitude_(read_double_parameter(private_node, "amplitude", 0.3)),
+      frequency_(read_double_parameter(private_node, "frequency", 0.25)),
+      drive_torque_(read_double_parameter(private_node, "drive_torque", 5.0)),
+      steering_joint_(private_node.param<std::string>("steering_joint", "steering_joint")),
+      shut_down_on_refusal_(shut_down_on_refusal) {
   if (!std::isfinite(kp_) || !std::isfinite(kd_) || !std::isfinite(amplitude_) || !std::isfinite(frequency_) ||
       !std::isfinite(drive_torque_)) {
     throw std::invalid_argument("~kp, ~kd, ~amplitude, ~frequency and ~drive_torque must be finite");
+  }
+  if (steering_joint_.empty()) throw std::invalid_argument("~steering_joint must name a joint (it is empty)");
+  static const std::vector<std::string> kKnown = {"kp", "kd", "amplitude", "frequency", "drive_torque",
+                                                  "steering_joint", "inline_answers"};
+  for (const std::string& report : unknown_private_parameters(private_node, kKnown)) {
+    ROS_WARN("steering_pd_controller: %s", report.c_str());
   }
   steering_publisher_ = node.advertise<std_msgs::Float64>("steering_torque", 100);
   drive_publisher_ = node.advertise<std_msgs::Float64>("drive_torque", 100);
@@ -27,15 +39,31 @@ SteeringPdController::SteeringPdController(ros::NodeHandle node, ros::NodeHandle
   if (inline_answers) subscribing.setCallbackQueue(&inline_queue_);
   subscriber_ = subscribing.subscribe<sensor_msgs::JointState>(
       "joint_states", 100, &SteeringPdController::on_joint_states, this, ros::TransportHints().tcpNoDelay());
+  joint_check_ = node.createWallTimer(ros::WallDuration(0.1), &SteeringPdController::check_joint_name, this);
   ROS_INFO("steering_pd_controller: chi_ref = %g sin(2 pi %g t) rad, kp = %g N m/rad, kd = %g N m s/rad, drive %g N m",
            amplitude_, frequency_, kp_, kd_, drive_torque_);
 }
 
 void SteeringPdController::on_joint_states(const sensor_msgs::JointState::ConstPtr& joints) {
-  const auto found = std::find(joints->name.begin(), joints->name.end(), "steering_joint");
+  if (refused_) return;
+  const auto found = std::find(joints->name.begin(), joints->name.end(), steering_joint_);
   const std::size_t index = static_cast<std::size_t>(std::distance(joints->name.begin(), found));
-  if (found == joints->name.end() || index >= joints->position.size() || index >= joints->velocity.size()) {
-    ROS_ERROR_THROTTLE(1.0, "steering_pd_controller: joint_states without steering_joint position and velocity");
+  if (found == joints->name.end()) {
+    // Another publisher's partial joint_states may lack it; the name is refused only when no
+    // message has held it within kJointGrace (check_joint_name).
+    if (!steering_joint_seen_) {
+      const std::lock_guard<std::mutex> lock(missing_joint_mutex_);
+      if (!first_without_joint_) {
+        first_without_joint_ = ros::WallTime::now();
+        names_without_joint_ = joints->name;
+      }
+    }
+    return;
+  }
+  if (!steering_joint_seen_) steering_joint_seen_ = true;
+  if (index >= joints->position.size() || index >= joints->velocity.size()) {
+    ROS_ERROR_THROTTLE(1.0, "steering_pd_controller: joint_states names %s without its position and velocity",
+                       steering_joint_.c_str());
     return;
   }
   const double time = joints->header.stamp.toSec();                        // t [s]
@@ -48,6 +76,33 @@ void SteeringPdController::on_joint_states(const sensor_msgs::JointState::ConstP
   drive->data = drive_torque_;
   drive_publisher_.publish(drive);
   steering_publisher_.publish(steering);
+}
+
+void SteeringPdController::check_joint_name(const ros::WallTimerEvent&) {
+  if (steering_joint_seen_) {
+    joint_check_.stop();
+    return;
+  }
+  std::vector<std::string> seen_names;
+  {
+    const std::lock_guard<std::mutex> lock(missing_joint_mutex_);
+    if (!first_without_joint_ || (ros::WallTime::now() - *first_without_joint_).toSec() < kJointGrace) return;
+    seen_names = names_without_joint_;
+  }
+  std::string names;
+  for (const std::string& name : seen_names) names += (names.empty() ? "" : ", ") + name;
+  const std::string guess = closest_name(steering_joint_, seen_names);
+  refusal_ = "joint '" + steering_joint_ + "' (~steering_joint) is not in " + subscriber_.getTopic() + ", which names " +
+             (names.empty() ? "no joint" : names) + (guess.empty() ? "" : " (did you mean '" + guess + "'?)") +
+             ": without the steering angle the controller cannot steer, so it does not run";
+  refused_ = true;
+  ROS_FATAL("steering_pd_controller: %s", refusal_.c_str());
+  joint_check_.stop();
+  if (shut_down_on_refusal_) {
+    ros::shutdown();
+  } else {  // a nodelet: the manager and cart_sim go on
+    subscriber_.shutdown();
+  }
 }
 
 }  // namespace birkhoff_cart

@@ -69,7 +69,8 @@ class SteeringPdControllerNodelet : public nodelet::Nodelet {
   void onInit() override {
     try {
       const bool inline_answers = getPrivateNodeHandle().param("inline_answers", true);
-      controller_ = std::make_unique<SteeringPdController>(getNodeHandle(), getPrivateNodeHandle(), inline_answers);
+      controller_ = std::make_unique<SteeringPdController>(getNodeHandle(), getPrivateNodeHandle(), inline_answers,
+                                                          /*shut_down_on_refusal=*/false);
     } catch (const std::invalid_argument& error) {
       NODELET_FATAL("steering_pd_controller: %s", error.what());
     }

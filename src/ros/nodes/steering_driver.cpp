@@ -5,11 +5,13 @@
 // (config/scenes/driven.yaml); launch/driven.launch starts both.
 // Exit codes: 0 shut down, 2 refused at start (bad parameter, name or remapping), 4 unexpected error.
 #include <cmath>
+#include <string>
 
 #include <ros/ros.h>
 #include <std_msgs/Float64.h>
 #include "birkhoff_cart/core/version.h"
 #include "birkhoff_cart/ros/node_main.h"
+#include "birkhoff_cart/ros/parameter_reading.h"
 
 namespace {
 
@@ -28,6 +30,10 @@ int main(int argc, char** argv) {
     const double frequency = private_node.param("frequency", 0.2);  // [Hz]
     const double offset = private_node.param("offset", 0.0);        // [N·m]
     const double rate = private_node.param("rate", 50.0);           // [Hz]
+    for (const std::string& report :
+         birkhoff_cart::unknown_private_parameters(private_node, {"amplitude", "frequency", "offset", "rate"})) {
+      ROS_WARN("steering_driver: %s", report.c_str());
+    }
     // The timer period 1/rate must be a ros::Duration (at most 2^31 - 1 s) and longer than 0 ns.
     if (!(rate >= kLowestRate && rate <= kHighestRate) || !std::isfinite(amplitude) || !std::isfinite(frequency) ||
         !std::isfinite(offset)) {

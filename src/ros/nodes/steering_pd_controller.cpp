@@ -1,7 +1,8 @@
 // steering_pd_controller: an example controller for cart_sim's lockstep mode (docs/ros_interface.md, "Node
 // steering_pd_controller"). All the work is in SteeringPdController (also the nodelet
 // birkhoff_cart/SteeringPdController).
-// Exit codes: 0 shut down, 2 refused at start (bad parameter, name or remapping), 4 unexpected error.
+// Exit codes: 0 shut down, 2 refused (bad parameter, name or remapping at start; a ~steering_joint
+// that joint_states does not hold, within a second), 4 unexpected error.
 #include <stdexcept>
 
 #include <ros/ros.h>
@@ -18,6 +19,7 @@ int main(int argc, char** argv) {
     try {
       birkhoff_cart::SteeringPdController controller(node, ros::NodeHandle("~"));
       ros::spin();
+      if (!controller.refusal().empty()) return birkhoff_cart::kNodeExitRefused;  // ~steering_joint not in joint_states
     } catch (const std::invalid_argument& error) {
       ROS_FATAL("steering_pd_controller: %s", error.what());
       return birkhoff_cart::kNodeExitRefused;
