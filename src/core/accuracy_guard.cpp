@@ -9,10 +9,6 @@
 namespace birkhoff_cart {
 namespace {
 
-constexpr AccuracyQuantity kLimitedQuantities[] = {AccuracyQuantity::kEnergyBalanceRelative,
-                                                   AccuracyQuantity::kP2Balance, AccuracyQuantity::kConstraint,
-                                                   AccuracyQuantity::kEstimatedError};
-
 int index_of(AccuracyQuantity quantity) { return static_cast<int>(quantity); }
 
 std::string format_number(double value) {
@@ -52,6 +48,7 @@ const char* to_string(AccuracyQuantity quantity) {
     case AccuracyQuantity::kP2Balance: return "p2_balance";
     case AccuracyQuantity::kConstraint: return "constraint";
     case AccuracyQuantity::kEstimatedError: return "estimated_error";
+    case AccuracyQuantity::kEnergyBalance: return "energy_balance";
     case AccuracyQuantity::kNonFinite: return "non_finite";
   }
   return "?";
@@ -61,6 +58,7 @@ const char* unit_of(AccuracyQuantity quantity) {
   switch (quantity) {
     case AccuracyQuantity::kP2Balance: return "kg·m²/s";
     case AccuracyQuantity::kConstraint: return "m/s";
+    case AccuracyQuantity::kEnergyBalance: return "J";
     default: return "-";
   }
 }
@@ -71,6 +69,7 @@ const AccuracyLimit& AccuracyRequirements::limit(AccuracyQuantity quantity) cons
     case AccuracyQuantity::kP2Balance: return p2_balance;
     case AccuracyQuantity::kConstraint: return constraint;
     case AccuracyQuantity::kEstimatedError: return estimated_error;
+    case AccuracyQuantity::kEnergyBalance: return energy_balance;
     case AccuracyQuantity::kNonFinite: break;
   }
   throw std::invalid_argument("non_finite has no limit");
@@ -81,7 +80,7 @@ AccuracyLimit& AccuracyRequirements::limit(AccuracyQuantity quantity) {
 }
 
 void validate(const AccuracyRequirements& requirements) {
-  for (AccuracyQuantity quantity : kLimitedQuantities) {
+  for (AccuracyQuantity quantity : kLimitedAccuracyQuantities) {
     const AccuracyLimit& limit = requirements.limit(quantity);
     if (!limit.enabled) continue;
     if (!std::isfinite(limit.warn) || !std::isfinite(limit.error) || !(limit.warn > 0.0) ||
@@ -108,6 +107,7 @@ AccuracyLevel AccuracyGuard::check(double time, const Diagnostics& diagnostics, 
   relative = energy_scale_ > 0.0 ? energy_residual / energy_scale_
              : energy_residual == 0.0 ? 0.0 : std::numeric_limits<double>::infinity();
   if (std::isnan(energy_residual)) relative = energy_residual;
+  current_[index_of(AccuracyQuantity::kEnergyBalance)] = energy_residual;
   current_[index_of(AccuracyQuantity::kP2Balance)] = std::abs(diagnostics.p2_balance_residual);
   current_[index_of(AccuracyQuantity::kConstraint)] = std::abs(diagnostics.max_constraint_residual);
   current_[index_of(AccuracyQuantity::kEstimatedError)] =
@@ -131,7 +131,7 @@ AccuracyLevel AccuracyGuard::check(double time, const Diagnostics& diagnostics, 
   };
 
   current_level_ = AccuracyLevel::kOk;
-  for (AccuracyQuantity quantity : kLimitedQuantities) {
+  for (AccuracyQuantity quantity : kLimitedAccuracyQuantities) {
     const int i = index_of(quantity);
     const double value = current_[i];
     if (!std::isnan(value)) largest_[i] = std::max(largest_[i], value);
@@ -173,7 +173,7 @@ std::string AccuracyGuard::current_summary() const {
   std::string line = to_string(current_level_);
   line += ":";
   bool first = true;
-  for (AccuracyQuantity quantity : kLimitedQuantities) {
+  for (AccuracyQuantity quantity : kLimitedAccuracyQuantities) {
     const AccuracyLimit& limit = requirements_.limit(quantity);
     const double value = current_[index_of(quantity)];
     if (!limit.enabled || !(value > limit.warn)) continue;

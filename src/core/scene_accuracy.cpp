@@ -6,6 +6,7 @@
 //     ...
 //
 // Each key is optional and keeps its default when absent; `off` disables a quantity.
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -17,9 +18,8 @@ namespace scene_detail {
 AccuracyRequirements read_accuracy(const SceneReader& reader, const YAML::Node& node) {
   AccuracyRequirements requirements;
   if (!node || node.IsNull()) return requirements;
-  const std::vector<AccuracyQuantity> quantities = {AccuracyQuantity::kEnergyBalanceRelative,
-                                                    AccuracyQuantity::kP2Balance, AccuracyQuantity::kConstraint,
-                                                    AccuracyQuantity::kEstimatedError};
+  const std::vector<AccuracyQuantity> quantities(std::begin(kLimitedAccuracyQuantities),
+                                                  std::end(kLimitedAccuracyQuantities));
   std::vector<std::string> names;
   for (AccuracyQuantity quantity : quantities) names.push_back(to_string(quantity));
   reader.require_map(node, "accuracy", names);

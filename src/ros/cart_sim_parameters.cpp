@@ -139,20 +139,6 @@ CartSimParameters load_parameters(const ros::NodeHandle& private_node) {
   parameters.diagnostic_period = read_double_parameter(p, "diagnostic_period", parameters.diagnostic_period);
   require(std::isfinite(parameters.diagnostic_period) && parameters.diagnostic_period > 0.0,
           "~diagnostic_period must be > 0 s");
-  parameters.energy_residual_warn = read_double_parameter(p, "energy_residual_warn", parameters.energy_residual_warn);
-  parameters.energy_residual_error = read_double_parameter(p, "energy_residual_error", parameters.energy_residual_error);
-  parameters.p2_residual_warn = read_double_parameter(p, "p2_residual_warn", parameters.p2_residual_warn);
-  parameters.p2_residual_error = read_double_parameter(p, "p2_residual_error", parameters.p2_residual_error);
-  parameters.constraint_residual_warn = read_double_parameter(p, "constraint_residual_warn", parameters.constraint_residual_warn);
-  parameters.constraint_residual_error =
-      read_double_parameter(p, "constraint_residual_error", parameters.constraint_residual_error);
-  require(parameters.energy_residual_warn > 0.0 && parameters.energy_residual_warn <= parameters.energy_residual_error,
-          "~energy_residual_warn must be > 0 and <= ~energy_residual_error [J]");
-  require(parameters.p2_residual_warn > 0.0 && parameters.p2_residual_warn <= parameters.p2_residual_error,
-          "~p2_residual_warn must be > 0 and <= ~p2_residual_error [N m s]");
-  require(parameters.constraint_residual_warn > 0.0 &&
-              parameters.constraint_residual_warn <= parameters.constraint_residual_error,
-          "~constraint_residual_warn must be > 0 and <= ~constraint_residual_error [m/s]");
   return parameters;
 }
 }  // namespace birkhoff_cart

@@ -28,36 +28,10 @@ void CartSimNode::produce_diagnostics(diagnostic_updater::DiagnosticStatusWrappe
   const Diagnostics diagnostics = simulation_->diagnostics();
   const double real_time_factor = this->real_time_factor();
 
-  struct Check {
-    const char* name;
-    double value;
-    double warn;
-    double error;
-  };
-  const Check checks[] = {
-      {"energy-balance residual", std::abs(diagnostics.energy_balance_residual), parameters_.energy_residual_warn,
-       parameters_.energy_residual_error},
-      {"p2-balance residual", std::abs(diagnostics.p2_balance_residual), parameters_.p2_residual_warn,
-       parameters_.p2_residual_error},
-      {"constraint residual", diagnostics.max_constraint_residual, parameters_.constraint_residual_warn,
-       parameters_.constraint_residual_error},
-  };
+  // One threshold system: the level is the accuracy guard's (ros_accuracy::report below), raised
+  // by rejected commands and a failed step.
   unsigned char level = diagnostic_msgs::DiagnosticStatus::OK;
   std::string message;
-  for (const Check& check : checks) {
-    unsigned char check_level = diagnostic_msgs::DiagnosticStatus::OK;
-    if (!(check.value < check.error)) {  // NaN counts as an error
-      check_level = diagnostic_msgs::DiagnosticStatus::ERROR;
-    } else if (check.value >= check.warn) {
-      check_level = diagnostic_msgs::DiagnosticStatus::WARN;
-    }
-    if (check_level != diagnostic_msgs::DiagnosticStatus::OK) {
-      message += std::string(message.empty() ? "" : "; ") + check.name +
-                 (check_level == diagnostic_msgs::DiagnosticStatus::ERROR ? " above error threshold"
-                                                                           : " above warning threshold");
-    }
-    level = std::max(level, check_level);
-  }
   const std::uint64_t rejections = (steering_channel_ ? steering_channel_->rejected() : 0) +
                                    (drive_channel_ ? drive_channel_->rejected() : 0);
   if (rejections > diagnostics_rejections_seen_) {

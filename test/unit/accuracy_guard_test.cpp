@@ -80,6 +80,24 @@ TEST(AccuracyGuard, EnergyScaleIsTheLargestEnergySeenAndZeroOverZeroIsNoError) {
   EXPECT_DOUBLE_EQ(driven.current_value(AccuracyQuantity::kEnergyBalanceRelative), 5e-5);
 }
 
+TEST(AccuracyGuard, AbsoluteEnergyBalanceIsJudgedInJoulesAndOffByDefault) {
+  const StepStatistics statistics;
+  AccuracyGuard defaults;  // off: a 1 J residual on 1e6 J (1e-6) is fine for the relative limit
+  EXPECT_EQ(defaults.check(0.0, made_up(1e6, 1.0), statistics), AccuracyLevel::kOk);
+  EXPECT_EQ(defaults.current_value(AccuracyQuantity::kEnergyBalance), 1.0);
+  AccuracyRequirements requirements;
+  requirements.energy_balance = {true, 1e-4, 1e-1};  // [J]
+  AccuracyGuard guard(requirements);
+  EXPECT_EQ(guard.check(0.0, made_up(1e6, -1e-3), statistics), AccuracyLevel::kWarn);
+  EXPECT_EQ(guard.events().back().quantity, AccuracyQuantity::kEnergyBalance);
+  EXPECT_EQ(guard.check(1.0, made_up(1e6, 1.0), statistics), AccuracyLevel::kError);
+  const std::string summary = guard.summary();
+  EXPECT_NE(summary.find("energy_balance 1 > 0.1 J"), std::string::npos) << summary;
+  EXPECT_EQ(summary.find("energy_balance_relative"), std::string::npos) << summary;  // 1e-6 of T*: fine
+  requirements.energy_balance = {true, 1.0, 0.5};
+  EXPECT_THROW(AccuracyGuard{requirements}, std::invalid_argument);
+}
+
 TEST(AccuracyGuard, EveryQuantityTripsOnItsOwnLimitAndNonFiniteIsAlwaysError) {
   AccuracyRequirements requirements;
   requirements.p2_balance = {true, 1e-8, 1e-6};
@@ -145,9 +163,14 @@ TEST(AccuracyGuardScene, ReadsLimitsAndOffAndRefusesBadOnesNamingTheKey) {
   EXPECT_TRUE(defaults.accuracy.energy_balance_relative.enabled);
   EXPECT_FALSE(defaults.accuracy.p2_balance.enabled);
 
+  EXPECT_FALSE(defaults.accuracy.energy_balance.enabled);
+
   const std::string path = write_scene(
-      "limits", base + "\naccuracy:\n  energy_balance_relative: off\n  p2_balance: {warn: 1.0e-9, error: 1.0e-7}\n");
+      "limits", base + "\naccuracy:\n  energy_balance_relative: off\n  p2_balance: {warn: 1.0e-9, error: 1.0e-7}\n"
+                       "  energy_balance: {warn: 1.0e-6, error: 1.0e-3}\n");
   const Scene scene = load_scene(path);
+  EXPECT_TRUE(scene.accuracy.energy_balance.enabled);
+  EXPECT_EQ(scene.accuracy.energy_balance.warn, 1e-6);
   EXPECT_FALSE(scene.accuracy.energy_balance_relative.enabled);
   EXPECT_TRUE(scene.accuracy.p2_balance.enabled);
   EXPECT_EQ(scene.accuracy.p2_balance.warn, 1e-9);
@@ -162,6 +185,7 @@ TEST(AccuracyGuardScene, ReadsLimitsAndOffAndRefusesBadOnesNamingTheKey) {
       {"  p2_balance: 1.0e-6\n", "accuracy.p2_balance"},
       {"  p2_balance: {warn: 1.0e-6, error: 1.0e-3, fatal: 1.0}\n", "accuracy.p2_balance.fatal"},
       {"  energy_error: off\n", "accuracy.energy_error"},
+      {"  energy_balance: {warn: 1.0, error: 1.0e-3}\n", "accuracy.energy_balance.warn"},
   };
   for (const auto& [lines, key] : bad) {
     const std::string bad_path = write_scene("bad", base + "\naccuracy:\n" + lines);

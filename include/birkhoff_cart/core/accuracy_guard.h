@@ -23,13 +23,20 @@ enum class AccuracyQuantity {
   kP2Balance,              ///< |p2 − p2₀ − ∫Q2 dt| [kg·m²/s]            key p2_balance
   kConstraint,             ///< max |eq. (15) residual| [m/s]            key constraint
   kEstimatedError,         ///< Σ ê, the summed local error estimates [-] key estimated_error
+  kEnergyBalance,          ///< |T* − T*₀ − ∫ω·Q dt| [J]                 key energy_balance
   kNonFinite,              ///< a diagnostic that is NaN or ±∞ (always ERROR; no key)
 };
-constexpr int kAccuracyQuantityCount = 5;
+constexpr int kAccuracyQuantityCount = 6;
+
+/// The quantities with limits (every one but kNonFinite), in the order they are checked and listed:
+/// the scene's `accuracy` keys, cart_sim's `~accuracy/<key>` parameters.
+constexpr AccuracyQuantity kLimitedAccuracyQuantities[] = {
+    AccuracyQuantity::kEnergyBalanceRelative, AccuracyQuantity::kP2Balance, AccuracyQuantity::kConstraint,
+    AccuracyQuantity::kEstimatedError, AccuracyQuantity::kEnergyBalance};
 
 /// The scene key / message name of a quantity ("energy_balance_relative", ..., "non_finite").
 const char* to_string(AccuracyQuantity quantity);
-/// Its unit, as printed after values ("-", "kg·m²/s", "m/s").
+/// Its unit, as printed after values ("-", "kg·m²/s", "m/s", "J").
 const char* unit_of(AccuracyQuantity quantity);
 
 /// One quantity's limits: WARN above `warn`, ERROR above `error` (0 < warn ≤ error). Disabled: never trips.
@@ -46,6 +53,7 @@ struct AccuracyRequirements {
   AccuracyLimit p2_balance{};                               ///< [kg·m²/s], off by default
   AccuracyLimit constraint{true, 1e-9, 1e-6};               ///< [m/s]
   AccuracyLimit estimated_error{};                          ///< [-], off by default
+  AccuracyLimit energy_balance{};                           ///< [J], off by default (absolute: scale-dependent)
 
   const AccuracyLimit& limit(AccuracyQuantity quantity) const;
   AccuracyLimit& limit(AccuracyQuantity quantity);

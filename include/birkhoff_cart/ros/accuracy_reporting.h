@@ -16,7 +16,10 @@ namespace birkhoff_cart {
 namespace ros_accuracy {
 
 /// `scene_requirements` with each ~accuracy/<quantity> parameter applied: the string "off", or a
-/// map {warn: W, error: E} (0 < W ≤ E, finite). Throws std::invalid_argument naming the parameter.
+/// map {warn: W, error: E} (0 < W ≤ E, finite); then the residual thresholds, each pair the limits
+/// of one quantity: ~energy_residual_warn/error → energy_balance [J], ~p2_residual_warn/error →
+/// p2_balance [kg·m²/s], ~constraint_residual_warn/error → constraint [m/s]. Throws
+/// std::invalid_argument naming the parameter (also when a pair and ~accuracy/<its quantity> are both set).
 AccuracyRequirements load_requirements(const ros::NodeHandle& private_node, const AccuracyRequirements& scene_requirements);
 
 /// Raises `status` to the guard's worst level (WARN/ERROR) with its line appended to the message,

@@ -42,12 +42,8 @@ struct CartSimParameters {
   bool follow_clock = false;                 ///< ~follow_clock: step only up to another node's /clock
   bool start_paused = false;                 ///< ~start_paused: wait for ~pause(false) before stepping
   double diagnostic_period = 1.0;            ///< ~diagnostic_period: /diagnostics every [s of scene time]
-  double energy_residual_warn = 1e-4;        ///< ~energy_residual_warn: |T* − T*₀ − W| [J]
-  double energy_residual_error = 1e-1;       ///< ~energy_residual_error: [J]
-  double p2_residual_warn = 1e-8;            ///< ~p2_residual_warn: |p2 − p2₀ − I2| [N·m·s]
-  double p2_residual_error = 1e-5;           ///< ~p2_residual_error: [N·m·s]
-  double constraint_residual_warn = 1e-9;    ///< ~constraint_residual_warn: max |(15)| [m/s]
-  double constraint_residual_error = 1e-6;   ///< ~constraint_residual_error: [m/s]
+  // The accuracy guard's limits (~accuracy/<quantity> and the residual thresholds mapped onto it)
+  // are read by ros_accuracy::load_requirements.
 };
 
 /// Every private parameter cart_sim reads, relative to its namespace ("accuracy/" covers the
