@@ -1,6 +1,7 @@
 #include "birkhoff_cart/core/simulation.h"
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -67,7 +68,30 @@ Simulation::Simulation(const Scene& scene)
 
 Simulation::~Simulation() = default;
 
-double Simulation::end_time() const { return scene_.initial_state.time + scene_.duration; }
+double Simulation::end_time() const {
+  return endless_ ? std::numeric_limits<double>::infinity() : schedule_.end_time;
+}
+
+void Simulation::plan_run(double duration) {
+  // step() lands on t₀ + n h counted from the run's start; a plan from the current time is on the
+  // same grid only at step 0.
+  if (steps_taken_ != 0) {
+    throw std::logic_error("scene '" + scene_.name + "': a run is planned only at its start (" +
+                           std::to_string(steps_taken_) + " steps taken)");
+  }
+  if (std::isinf(duration) && duration > 0.0) {
+    endless_ = true;
+    return;
+  }
+  const StepSchedule schedule = plan_steps(state_.time, duration, scene_.integrator.step_size);
+  schedule_ = schedule;
+  endless_ = false;
+}
+
+double Simulation::next_step_time() const {
+  if (!endless_ && steps_taken_ >= schedule_.whole_steps) return schedule_.end_time;
+  return state_.time + scene_.integrator.step_size;
+}
 
 void Simulation::step() {
   if (finished_off_grid_) {
@@ -84,7 +108,7 @@ void Simulation::step_on_schedule() {
     throw std::logic_error("scene '" + scene_.name + "' is already at its end t = " + std::to_string(state_.time) +
                            " s; reset() before stepping again");
   }
-  if (steps_taken_ < schedule_.whole_steps) step();
+  if (endless_ || steps_taken_ < schedule_.whole_steps) step();
   else step_to(schedule_.end_time);
 }
 
@@ -186,6 +210,7 @@ void Simulation::start_run(Scene run_scene) {
   // Commit: nothing below throws.
   scene_ = std::move(run_scene);
   schedule_ = schedule;
+  endless_ = false;
   reference_ = std::move(reference);
   stepper_ = std::move(stepper);
   state_ = state;

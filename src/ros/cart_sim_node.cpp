@@ -102,7 +102,7 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
     ROS_WARN("cart_sim: /use_sim_time is false, but every stamp cart_sim publishes is scene time (from t0 = %s s) "
              "and it drives /clock: nodes on wall time (tf listeners, rviz, robot_state_publisher) will drop "
              "its messages as too old. Set /use_sim_time true before starting them (every launch file of "
-             "birkhoff_cart does).", format_seconds(start_time).c_str());
+             "birkhoff_cart does, but lockstep.launch, whose loop reads only stamps).", format_seconds(start_time).c_str());
   }
   publish_period_ = 1.0 / parameters_.publish_rate;
   double real_time_factor = parameters_.real_time_factor;
@@ -232,18 +232,11 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
 CartSimNode::~CartSimNode() = default;
 
 void CartSimNode::restart_schedule() {
-  // Simulation::step() lands on t0 + n h counted from the scene's start; the plan's grid is the same
-  // only when made at step 0, which construction and reset() guarantee.
-  if (simulation_->steps_taken() != 0) {
-    throw std::logic_error("cart_sim: the run's schedule is planned only at the scene's start");
-  }
   // From the current time to the run's end: the whole run after construction or ~reset, the rest of
   // it after a teleport (~set_state, /initialpose).
   const double start_time = simulation_->state().time;
   const bool whole_run = start_time == loaded_start_time_;
-  if (std::isfinite(end_time_)) {
-    schedule_ = plan_steps(start_time, whole_run ? run_duration_ : end_time_ - start_time, simulation_->step_size());
-  }
+  simulation_->plan_run(whole_run || !std::isfinite(end_time_) ? run_duration_ : end_time_ - start_time);
   // The odometry starts again at the true pose; after ~reset its noise runs again from the seed.
   if (odometry_sensor_) odometry_sensor_->start(simulation_->state(), whole_run);
   next_publish_index_ = 1;
@@ -253,15 +246,6 @@ void CartSimNode::restart_schedule() {
   pacing_.restart(WallClockPacing::Clock::now(), start_time);
 }
 
-bool CartSimNode::end_reached() const {
-  return schedule_ && simulation_->steps_taken() >= schedule_->total_steps();
-}
-
-double CartSimNode::next_step_time() const {
-  if (schedule_ && simulation_->steps_taken() >= schedule_->whole_steps) return schedule_->end_time;
-  return simulation_->state().time + simulation_->step_size();
-}
-
 bool CartSimNode::stop_requested() const { return stop_flag_ || shutdown_signal_received() || !ros::ok(); }
 
 bool CartSimNode::take_step() {
@@ -269,11 +253,7 @@ bool CartSimNode::take_step() {
   const double time_before = simulation_->state().time;
   try {
     // Whole steps onto t0 + n h, then the schedule's final step onto the end time exactly.
-    if (schedule_ && simulation_->steps_taken() >= schedule_->whole_steps) {
-      simulation_->step_to(schedule_->end_time);
-    } else {
-      simulation_->step();
-    }
+    simulation_->step_on_schedule();
   } catch (const StepError& error) {
     step_failure_ = error.what();
     return false;
@@ -286,7 +266,7 @@ bool CartSimNode::take_step() {
     clock_started_ = true;
     const double start = simulation_->scene().initial_state.time;
     const double time = simulation_->state().time;
-    if (!end_reached() &&
+    if (!simulation_->at_end() &&
         start + static_cast<double>(next_publish_index_) * publish_period_ > time + 0.5 * simulation_->step_size()) {
       publish_clock(time);
     }
@@ -308,7 +288,7 @@ int CartSimNode::run_loop(std::string& outcome) {
       wait_while_paused();
       continue;
     }
-    if (end_reached()) break;
+    if (simulation_->at_end()) break;
     // One batch: the steps up to the next publish instant (or the end). Between steps, callbacks
     // run when the transport has queued one (not in lockstep, where they run only at the barrier);
     // in real-time mode the node sleeps until a step is due.
@@ -325,7 +305,7 @@ int CartSimNode::run_loop(std::string& outcome) {
     double due_scene_time = -std::numeric_limits<double>::infinity();  // [s]
     // Steps asked for by ~step while paused run as fast as they can (not paced).
     const bool paced = pacing_.paced() && !paused_;
-    while (!end_reached() && simulation_->state().time + half_step < instant) {
+    while (!simulation_->at_end() && simulation_->state().time + half_step < instant) {
       if (halted()) {  // the ~step request is done (its last step was not on an instant)
         interrupted = true;
         break;
@@ -333,7 +313,7 @@ int CartSimNode::run_loop(std::string& outcome) {
       // Real time: a step is due once the wall clock has reached its scene time (half a step early
       // is fine). Steps due are run back to back; only a node that has caught up runs callbacks or
       // sleeps, so a command takes effect at the first step after its arrival in scene time too.
-      const double next_time = next_step_time();
+      const double next_time = simulation_->next_step_time();
       // The scene time due by now is read from the clock only when the last reading no longer
       // covers the next step (one clock read per catch-up, not per step).
       if (paced && due_scene_time < next_time - half_step) {
@@ -374,7 +354,7 @@ int CartSimNode::run_loop(std::string& outcome) {
     const double time = simulation_->state().time;
     // The publish instants due by now, and the run's end t0 + T (an instant or not), published once.
     const bool instant_due = pass_due_instants(start, publish_period_, time, half_step, next_publish_index_);
-    if (instant_due || end_reached()) {
+    if (instant_due || simulation_->at_end()) {
       publish_clock(time);
       publish_instant();
       if (record_failure_) break;

@@ -23,7 +23,7 @@ void place_hinge(CartState& state, double base_x, double base_y, double heading,
 }  // namespace
 
 bool CartSimNode::teleport(const CartState& target, const std::string& source, std::string& message) {
-  if (end_reached()) {
+  if (simulation_->at_end()) {
     message = source + " refused: the run has ended at t = " + format_seconds(simulation_->state().time) + " s";
     ROS_ERROR("cart_sim: %s", message.c_str());
     return false;

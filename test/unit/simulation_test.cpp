@@ -64,6 +64,44 @@ TEST(Simulation, StepToLandsOnAnEndTimeOffTheGridAndEndsTheRun) {
   EXPECT_EQ(simulation.state().time, simulation.scene().initial_state.time + simulation.step_size());
 }
 
+TEST(Simulation, PlanRunSetsTheRunsOwnEndOrNoneAndResetRestoresTheScenes) {
+  Simulation simulation(load("paper_special"));  // t₀ = π/2, h = 1e-3
+  const double t0 = simulation.scene().initial_state.time;
+  const double h = simulation.step_size();
+  const double scene_end = simulation.end_time();
+  // A run of 0.0105 s from t₀: 10 whole steps, then the final one of 0.5 h onto t₀ + 0.0105.
+  simulation.plan_run(0.0105);
+  EXPECT_TRUE(simulation.has_end());
+  EXPECT_EQ(simulation.end_time(), t0 + 0.0105);
+  EXPECT_EQ(simulation.schedule().whole_steps, 10u);
+  int steps = 0;
+  while (!simulation.at_end()) {
+    const double expected = simulation.next_step_time();
+    simulation.step_on_schedule();
+    EXPECT_EQ(simulation.state().time, steps < 10 ? t0 + static_cast<double>(steps + 1) * h : t0 + 0.0105);
+    EXPECT_NEAR(simulation.state().time, expected, 1e-15);
+    ++steps;
+  }
+  EXPECT_EQ(steps, 11);
+  EXPECT_THROW(simulation.plan_run(1.0), std::logic_error);  // only at a run's start
+  EXPECT_THROW(simulation.step_on_schedule(), std::logic_error);
+  simulation.reset();
+  EXPECT_EQ(simulation.end_time(), scene_end);  // reset plans the scene's run again
+  // A duration the rule refuses changes nothing.
+  EXPECT_THROW(simulation.plan_run(0.0), TimeLimitError);
+  EXPECT_THROW(simulation.plan_run(-1.0), TimeLimitError);
+  EXPECT_EQ(simulation.end_time(), scene_end);
+  EXPECT_TRUE(simulation.has_end());
+  // Without end: whole steps for ever, never at_end (free_coast: 6 s, h = 1 ms).
+  Simulation endless(load("free_coast"));
+  endless.plan_run(std::numeric_limits<double>::infinity());
+  EXPECT_FALSE(endless.has_end());
+  EXPECT_EQ(endless.end_time(), std::numeric_limits<double>::infinity());
+  for (int n = 1; n <= 6500; ++n) endless.step_on_schedule();  // beyond the scene's 6 s
+  EXPECT_FALSE(endless.at_end());
+  EXPECT_EQ(endless.state().time, 6500.0 * 1e-3);
+}
+
 TEST(Simulation, ResetRestoresEverythingAndTheRunRepeatsBitForBit) {
   Scene scene = load("driven");
   scene.integrator.name = "dopri5";  // also carries an adaptive step-size guess between steps

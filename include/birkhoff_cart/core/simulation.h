@@ -36,17 +36,28 @@ class Simulation {
   const CartModel& model() const { return model_; }
   const EffectSet& effects() const { return effects_; }
   const CartState& state() const { return state_; }
-  /// The scene's end time t0 + duration [s].
+  /// Where the run ends [s]: the scene's t0 + duration, or what plan_run() set (+inf: without end).
   double end_time() const;
-  /// How the scene's run is cut into steps (plan_steps of t₀, duration, h).
+  /// False after plan_run(+inf): the run has no end, and schedule() does not apply.
+  bool has_end() const { return !endless_; }
+  /// How the run is cut into steps (plan_steps of t₀, duration, h; the scene's, or plan_run()'s).
   const StepSchedule& schedule() const { return schedule_; }
   /// Steps taken since construction or reset() (whole and final).
   std::uint64_t steps_taken() const { return steps_taken_; }
-  /// True once the scene's schedule is done: the state is at end_time() exactly.
-  bool at_end() const { return steps_taken_ >= schedule_.total_steps(); }
-  /// The next step of the scene's schedule: step() while whole steps remain, then step_to(end_time())
-  /// if the schedule has a final step. Throws std::logic_error when at_end(), StepError as step().
+  /// True once the run's schedule is done: the state is at end_time() exactly (never without end).
+  bool at_end() const { return !endless_ && steps_taken_ >= schedule_.total_steps(); }
+  /// The next step of the run's schedule: step() while whole steps remain (always, without end),
+  /// then step_to(end_time()) if the schedule has a final step. Throws std::logic_error when
+  /// at_end(), StepError as step().
   void step_on_schedule();
+  /// Where step_on_schedule() will land next [s]: end_time() for the final step, else t + h.
+  double next_step_time() const;
+  /// A run of `duration` [s] from the current time instead of the scene's (a node's own run length;
+  /// the rest of a run after a teleport), cut by the rule of step_schedule.h; +inf: a run without
+  /// end. Only at a run's start (steps_taken() == 0: after construction, reset(), restart_from(),
+  /// which plan the scene's duration again). Throws std::logic_error after a step, TimeLimitError
+  /// (key "duration") for a duration the rule refuses; nothing changes then.
+  void plan_run(double duration);
   double step_size() const { return scene_.integrator.step_size; }
   const std::string& integrator_name() const { return scene_.integrator.name; }
 
@@ -122,6 +133,7 @@ class Simulation {
 
   std::uint64_t steps_taken_ = 0;
   bool finished_off_grid_ = false;  ///< step_to() left the grid t₀ + n h
+  bool endless_ = false;            ///< plan_run(+inf): no end, schedule_ unused
   StepStatistics statistics_;
   double initial_energy_ = 0.0;
   double initial_steering_momentum_ = 0.0;

@@ -16,9 +16,10 @@
 //    there, so a closed loop through another node is the same on every run.
 //
 // The member functions are defined by job: cart_sim_node.cpp (construction and the time loop),
-// cart_sim_pacing.cpp (callbacks, real-time deadlines, the lockstep barrier), cart_sim_publishing.cpp,
-// cart_sim_services.cpp (commands, ~reset, ~pause), cart_sim_teleport.cpp (~set_state, /initialpose,
-// ~step) and cart_sim_summary.cpp (diagnostics, summary).
+// cart_sim_pacing.cpp (callbacks, real-time deadlines, the lockstep barrier, following /clock),
+// cart_sim_publishing.cpp, cart_sim_services.cpp (commands, ~reset, ~pause), cart_sim_teleport.cpp
+// (~set_state, /initialpose, ~step), cart_sim_progress.cpp (the fast mode's progress line) and
+// cart_sim_summary.cpp (diagnostics, summary).
 #pragma once
 
 #include <atomic>
@@ -116,14 +117,11 @@ class CartSimNode {
   void end_step_requests();
 
   // cart_sim_node.cpp
-  /// Plans the run from the current state (construction, ~reset: the simulation's step count is 0)
-  /// and restarts the publish instants and the pacing there.
+  /// Plans the run in the simulation from the current state (Simulation::plan_run; construction,
+  /// ~reset, a teleport: the simulation's step count is 0) and restarts the publish instants and
+  /// the pacing there. The simulation then owns the schedule: at_end(), next_step_time().
   void restart_schedule();
   void apply_watchdogs();
-  /// True once the run's schedule is done: the state is at end_time_ exactly (never without an end).
-  bool end_reached() const;
-  /// The scene time the next step lands on: t + h, or the end time for the schedule's final step [s].
-  double next_step_time() const;
   /// The next step of the run's schedule (watchdogs first); false when it failed (step_failure_ set).
   bool take_step();
 
@@ -145,15 +143,17 @@ class CartSimNode {
   /// and joint_states a subscriber (a state published before would be lost and its barrier time out).
   void wait_for_controllers();
   bool stop_requested() const;
-
-  // cart_sim_summary.cpp
-  void produce_diagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
   /// ~follow_clock: waits until the /clock another node drives reaches scene time `time` [s] (the
   /// end of the next batch of steps), so this cart's stamps are instants of that clock, never ahead.
   void wait_for_clock(double time);
+
+  // cart_sim_progress.cpp
   /// Fast mode: at most once per second of wall time, one log line with the scene time, the percent
   /// of the run done and the real-time factor since the last line.
   void report_progress();
+
+  // cart_sim_summary.cpp
+  void produce_diagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
   void write_summary(const std::string& outcome);
   /// Real-time factor over the run until `now`: scene time advanced / wall time not paused [-].
   double real_time_factor(WallClockPacing::Clock::time_point now = WallClockPacing::Clock::now()) const;
@@ -207,7 +207,6 @@ class CartSimNode {
   std::unique_ptr<diagnostic_updater::Updater> diagnostic_updater_;
 
   double run_duration_ = 0.0;             ///< T: the run's length from its start [s]; +inf = without end
-  std::optional<StepSchedule> schedule_;  ///< how the run is cut into steps (step_schedule.h); none without end
   double end_time_ = 0.0;                 ///< t0 + T, where the run stops exactly [s]; +inf = never
   double loaded_start_time_ = 0.0;        ///< the scene's t0 [s] (a teleport starts the run's rest elsewhere)
   double publish_period_ = 0.01;          ///< [s]
