@@ -110,33 +110,10 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   if (parameters_.follow_clock) real_time_factor = 0.0;  // the leader's /clock is the pace
   pacing_ = WallClockPacing(real_time_factor);
 
-  if (simulation_->accepts_steering_command()) {
-    steering_channel_.emplace(simulation_->steering_command(), parameters_.max_steering_torque,
-                              parameters_.command_timeout, start_time);
-  }
-  if (simulation_->accepts_drive_command()) {
-    drive_channel_.emplace(simulation_->drive_command(), parameters_.max_drive_torque, parameters_.command_timeout,
-                           start_time);
-  }
-
-  // The lockstep barrier: the command topics named by ~lockstep_topics, by default every one the
-  // scene takes commands on.
-  if (parameters_.lockstep) {
-    const auto wanted = [this](const std::string& topic) {
-      if (!parameters_.lockstep_topics_given) return true;
-      return std::find(parameters_.lockstep_topics.begin(), parameters_.lockstep_topics.end(), topic) !=
-             parameters_.lockstep_topics.end();
-    };
-    expect_steering_ = wanted("steering_torque");
-    expect_drive_ = wanted("drive_torque");
-    if ((expect_steering_ && !steering_channel_) || (expect_drive_ && !drive_channel_)) {
-      if (parameters_.lockstep_topics_given) {
-        throw NodeStartupError("~lockstep_topics names a command topic whose effect in scene " +
-                               parameters_.scene_path + " has no 'command' source");
-      }
-      expect_steering_ = expect_steering_ && steering_channel_.has_value();
-      expect_drive_ = expect_drive_ && drive_channel_.has_value();
-    }
+  try {
+    commands_.emplace(*simulation_, parameters_, start_time);
+  } catch (const std::invalid_argument& error) {
+    throw NodeStartupError(error.what());
   }
 
   // The record comes first: a node that cannot keep its record does not run at all.
@@ -181,19 +158,9 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   joint_state_topic_ = joint_state_publisher_.getTopic();
   integration_error_topic_ = integration_error_publisher_.getTopic();
   instant_messages_.emplace(parameters_.frames, parameters_.odometry_covariance);
-  // Only the commands the scene takes are subscribed: an idle subscription would be an unconnected
-  // one for roswtf, and a command sent to a scene without a command source shows up there as an
-  // unconnected publication instead.
-  // tcpNoDelay: a command is one small message; Nagle's algorithm would hold it back (lockstep
-  // waits for it every publish instant).
-  if (steering_channel_) {
-    steering_subscriber_ = node_.subscribe("steering_torque", 20, &CartSimNode::on_steering_torque, this,
-                                           ros::TransportHints().tcpNoDelay());
-  }
-  if (drive_channel_) {
-    drive_subscriber_ = node_.subscribe("drive_torque", 20, &CartSimNode::on_drive_torque, this,
-                                        ros::TransportHints().tcpNoDelay());
-  }
+  commands_->subscribe(node_, [this](const std::string& topic, double time, const std_msgs::Float64& message) {
+    record_command(topic, time, message);
+  });
   reset_service_ = private_node_.advertiseService("reset", &CartSimNode::on_reset, this);
   pause_service_ = private_node_.advertiseService("pause", &CartSimNode::on_pause, this);
   set_state_service_ = private_node_.advertiseService("set_state", &CartSimNode::on_set_state, this);
@@ -249,7 +216,7 @@ void CartSimNode::restart_schedule() {
 bool CartSimNode::stop_requested() const { return stop_flag_ || shutdown_signal_received() || !ros::ok(); }
 
 bool CartSimNode::take_step() {
-  apply_watchdogs();
+  commands_->apply_watchdogs();
   const double time_before = simulation_->state().time;
   try {
     // Whole steps onto t0 + n h, then the schedule's final step onto the end time exactly.
@@ -421,17 +388,12 @@ void CartSimNode::finish_record() {
   }
 }
 
-void CartSimNode::apply_watchdogs() {
-  const double time = simulation_->state().time;
-  if (steering_channel_ && steering_channel_->check_watchdog(time)) {
-    simulation_->set_steering_command(steering_channel_->torque());
-    ROS_WARN("cart_sim: no steering_torque command for %g s at t = %.6g s: steering torque set to 0",
-             steering_channel_->timeout(), time);
-  }
-  if (drive_channel_ && drive_channel_->check_watchdog(time)) {
-    simulation_->set_drive_command(drive_channel_->torque());
-    ROS_WARN("cart_sim: no drive_torque command for %g s at t = %.6g s: drive torque set to 0",
-             drive_channel_->timeout(), time);
+void CartSimNode::record_command(const std::string& topic, double time, const std_msgs::Float64& message) {
+  if (!recorder_ || record_failure_) return;
+  try {
+    recorder_->write(topic, ros_conversions::to_ros_time(time), message);
+  } catch (const std::exception& failure) {
+    record_failure_ = failure.what();
   }
 }
 

@@ -50,19 +50,15 @@ void CartSimNode::wait_while_paused() {
 
 void CartSimNode::wait_for_controllers() {
   const auto connected = [this] {
-    return (!expect_steering_ || steering_subscriber_.getNumPublishers() > 0) &&
-           (!expect_drive_ || drive_subscriber_.getNumPublishers() > 0) &&
-           joint_state_publisher_.getNumSubscribers() > 0;
+    return commands_->controllers_connected() && joint_state_publisher_.getNumSubscribers() > 0;
   };
   Clock::time_point next_note = after(parameters_.lockstep_timeout);
   while (!connected() && !stop_requested()) {
     callback_queue_.wait_until(after(0.01));
     process_callbacks();
     if (Clock::now() >= next_note) {
-      ROS_WARN("cart_sim: lockstep: waiting for a controller (publishers on %s%s%s and a joint_states subscriber)",
-               expect_steering_ ? steering_subscriber_.getTopic().c_str() : "",
-               expect_steering_ && expect_drive_ ? " and " : "",
-               expect_drive_ ? drive_subscriber_.getTopic().c_str() : "");
+      ROS_WARN("cart_sim: lockstep: waiting for a controller (publishers on %s and a joint_states subscriber)",
+               commands_->expected_topics().c_str());
       next_note = after(parameters_.lockstep_timeout);
     }
   }
@@ -70,9 +66,7 @@ void CartSimNode::wait_for_controllers() {
 
 void CartSimNode::wait_for_commands(double time) {
   const Clock::time_point give_up = after(parameters_.lockstep_timeout);
-  const auto answered = [this] {
-    return (!expect_steering_ || steering_answered_) && (!expect_drive_ || drive_answered_);
-  };
+  const auto answered = [this] { return commands_->answered(); };
   // Callbacks run only here in lockstep: everything queued since the last barrier (the answers,
   // ~pause, ~reset) takes effect at this instant.
   process_callbacks();
@@ -80,11 +74,9 @@ void CartSimNode::wait_for_commands(double time) {
     const Clock::time_point now = Clock::now();
     if (now >= give_up) {
       ++lockstep_timeouts_;
-      ROS_WARN("cart_sim: lockstep: no answer on %s%s%s within %g s of wall time after t = %.6g s; going on "
+      ROS_WARN("cart_sim: lockstep: no answer on %s within %g s of wall time after t = %.6g s; going on "
                "(%lu timeouts so far)",
-               expect_steering_ && !steering_answered_ ? "steering_torque" : "",
-               expect_steering_ && !steering_answered_ && expect_drive_ && !drive_answered_ ? " and " : "",
-               expect_drive_ && !drive_answered_ ? "drive_torque" : "", parameters_.lockstep_timeout, time,
+               commands_->unanswered_topics().c_str(), parameters_.lockstep_timeout, time,
                static_cast<unsigned long>(lockstep_timeouts_));
       break;
     }
@@ -96,19 +88,10 @@ void CartSimNode::wait_for_commands(double time) {
                                                            std::chrono::duration<double>(kLongestSleep))));
     process_callbacks();
   }
-  steering_answered_ = false;
-  drive_answered_ = false;
-  std::stable_sort(lockstep_records_.begin(), lockstep_records_.end(),
-                   [](const auto& a, const auto& b) { return a.first < b.first; });
-  for (const auto& [topic, message] : lockstep_records_) {
-    if (!recorder_ || record_failure_) break;
-    try {
-      recorder_->write(topic, ros_conversions::to_ros_time(time), message);
-    } catch (const std::exception& failure) {
-      record_failure_ = failure.what();
-    }
-  }
-  lockstep_records_.clear();
+  // The answers are recorded at the instant they answer, in the order of their topics' names.
+  commands_->end_barrier(time, [this](const std::string& topic, double instant, const std_msgs::Float64& message) {
+    record_command(topic, instant, message);
+  });
   // The wait is the controllers' time, not the simulator's: real-time pacing starts again here.
   if (pacing_.paced()) pacing_.restart(Clock::now(), simulation_->state().time);
 }

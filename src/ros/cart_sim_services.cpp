@@ -1,75 +1,16 @@
-// cart_sim's inputs: the command topics and the ~reset and ~pause services (see cart_sim_node.h).
+// cart_sim's ~reset and ~pause services and the bag of each run (see cart_sim_node.h).
 #include "birkhoff_cart/ros/cart_sim_node.h"
 
 #include <algorithm>
 
 namespace birkhoff_cart {
 
-void CartSimNode::receive_command(CommandChannel& channel, const std::string& topic,
-                                  const std_msgs::Float64& message) {
-  const double time = simulation_->state().time;
-  const CommandChannel::Outcome outcome = channel.receive(message.data, time);
-  if (outcome == CommandChannel::Outcome::kRejected) {
-    ROS_ERROR_THROTTLE(1.0, "cart_sim: rejected non-finite %s command (%g) at t = %.6g s (%lu rejected so far)",
-                       topic.c_str(), message.data, time, static_cast<unsigned long>(channel.rejected()));
-  } else if (outcome == CommandChannel::Outcome::kClamped) {
-    ROS_WARN_THROTTLE(1.0, "cart_sim: %s command %g clamped to %g N m", topic.c_str(), message.data,
-                      channel.torque());
-  }
-  if (steering_channel_ && &channel == &*steering_channel_) steering_answered_ = true;
-  if (drive_channel_ && &channel == &*drive_channel_) drive_answered_ = true;
-  if (parameters_.lockstep) {
-    // Answers arrive over separate connections in any order; they are recorded at the barrier in
-    // the order of the topics' names, so two identical runs record identical bags.
-    lockstep_records_.emplace_back(topic, message);
-    return;
-  }
-  if (recorder_ && !record_failure_) {
-    try {
-      recorder_->write(topic, ros_conversions::to_ros_time(std::max(time, 0.0)), message);
-    } catch (const std::exception& failure) {
-      record_failure_ = failure.what();
-    }
-  }
-}
-
-void CartSimNode::on_steering_torque(const std_msgs::Float64::ConstPtr& message) {
-  if (!steering_channel_) {
-    ROS_WARN_THROTTLE(5.0, "cart_sim: scene '%s' has no steering_torque effect with source 'command': "
-                      "ignoring %s", simulation_->scene().name.c_str(), steering_subscriber_.getTopic().c_str());
-    return;
-  }
-  receive_command(*steering_channel_, steering_subscriber_.getTopic(), *message);
-  simulation_->set_steering_command(steering_channel_->torque());
-}
-
-void CartSimNode::on_drive_torque(const std_msgs::Float64::ConstPtr& message) {
-  if (!drive_channel_) {
-    ROS_WARN_THROTTLE(5.0, "cart_sim: scene '%s' has no drive_torque effect with source 'command': ignoring %s",
-                      simulation_->scene().name.c_str(), drive_subscriber_.getTopic().c_str());
-    return;
-  }
-  receive_command(*drive_channel_, drive_subscriber_.getTopic(), *message);
-  simulation_->set_drive_command(drive_channel_->torque());
-}
-
-void CartSimNode::restart_commands(double time) {
-  if (steering_channel_) {
-    steering_channel_->restart(time);
-    simulation_->set_steering_command(steering_channel_->torque());
-  }
-  if (drive_channel_) {
-    drive_channel_->restart(time);
-    simulation_->set_drive_command(drive_channel_->torque());
-  }
-}
-
 bool CartSimNode::on_reset(std_srvs::Empty::Request& /*request*/, std_srvs::Empty::Response& /*response*/) {
   simulation_->reset();
   accuracy_guard_.reset();
   ++resets_;
   const double start_time = simulation_->state().time;
-  restart_commands(start_time);
+  commands_->restart(start_time);
   restart_schedule();
   // Each run gets its own bag: one bag across a reset would hold overlapping times of two runs,
   // which playback interleaves.

@@ -32,8 +32,7 @@ void CartSimNode::produce_diagnostics(diagnostic_updater::DiagnosticStatusWrappe
   // by rejected commands and a failed step.
   unsigned char level = diagnostic_msgs::DiagnosticStatus::OK;
   std::string message;
-  const std::uint64_t rejections = (steering_channel_ ? steering_channel_->rejected() : 0) +
-                                   (drive_channel_ ? drive_channel_->rejected() : 0);
+  const std::uint64_t rejections = commands_->rejected();
   if (rejections > diagnostics_rejections_seen_) {
     level = std::max<unsigned char>(level, diagnostic_msgs::DiagnosticStatus::WARN);
     message += std::string(message.empty() ? "" : "; ") + "non-finite commands rejected";
@@ -68,8 +67,8 @@ void CartSimNode::produce_diagnostics(diagnostic_updater::DiagnosticStatusWrappe
     status.add(name + " commands clamped", channel ? channel->clamped() : 0);
     status.add(name + " command timeouts", channel ? channel->timeouts() : 0);
   };
-  add_channel("steering_torque", steering_channel_);
-  add_channel("drive_torque", drive_channel_);
+  add_channel("steering_torque", commands_->steering());
+  add_channel("drive_torque", commands_->drive());
   // The actuators' state (docs/actuators.md): what was commanded, what the cart receives.
   const Simulation::ActuatorStatus actuators = simulation_->actuator_status();
   if (actuators.steering_actuator) {

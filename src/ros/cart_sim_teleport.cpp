@@ -38,7 +38,7 @@ bool CartSimNode::teleport(const CartState& target, const std::string& source, s
   accuracy_guard_.reset();
   ++resets_;  // a batch in progress stops: its publish instants belonged to the old start
   const double time = simulation_->state().time;
-  restart_commands(time);
+  commands_->restart(time);
   restart_schedule();
   const Eigen::Vector2d base = simulation_->model().rear_axle_midpoint(target);
   std::ostringstream text;

@@ -15,9 +15,11 @@
 //    every expected command topic has answered (or ~lockstep_timeout), and callbacks run only
 //    there, so a closed loop through another node is the same on every run.
 //
+// Parts with a job of their own are classes: CommandInputs (the command topics, their watchdogs and
+// the lockstep answers), InstantMessages (the messages of a publish instant).
 // The member functions are defined by job: cart_sim_node.cpp (construction and the time loop),
 // cart_sim_pacing.cpp (callbacks, real-time deadlines, the lockstep barrier, following /clock),
-// cart_sim_publishing.cpp, cart_sim_services.cpp (commands, ~reset, ~pause), cart_sim_teleport.cpp
+// cart_sim_publishing.cpp, cart_sim_services.cpp (~reset, ~pause, the bag), cart_sim_teleport.cpp
 // (~set_state, /initialpose, ~step), cart_sim_progress.cpp (the fast mode's progress line) and
 // cart_sim_summary.cpp (diagnostics, summary).
 #pragma once
@@ -48,7 +50,7 @@
 #include "birkhoff_cart/core/simulation.h"
 #include "birkhoff_cart/ros/bag_recorder.h"
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
-#include "birkhoff_cart/ros/command_channel.h"
+#include "birkhoff_cart/ros/command_inputs.h"
 #include "birkhoff_cart/ros/conversions.h"
 #include "birkhoff_cart/ros/instant_messages.h"
 #include "birkhoff_cart/ros/shutdown_signals.h"
@@ -91,14 +93,9 @@ class CartSimNode {
   void finish_record();
 
   // cart_sim_services.cpp
-  void on_steering_torque(const std_msgs::Float64::ConstPtr& message);
-  void on_drive_torque(const std_msgs::Float64::ConstPtr& message);
-  void receive_command(CommandChannel& channel, const std::string& topic, const std_msgs::Float64& message);
   bool on_reset(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   bool on_pause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
   void open_record(const std::string& path);
-  /// The command channels' hold and watchdogs start again at scene time `time` [s] (~reset, teleports).
-  void restart_commands(double time);
 
   // cart_sim_teleport.cpp
   bool on_set_state(SetCartState::Request& request, SetCartState::Response& response);
@@ -121,7 +118,8 @@ class CartSimNode {
   /// ~reset, a teleport: the simulation's step count is 0) and restarts the publish instants and
   /// the pacing there. The simulation then owns the schedule: at_end(), next_step_time().
   void restart_schedule();
-  void apply_watchdogs();
+  /// Into the bag (while it can be written): a command message at scene time `time` [s].
+  void record_command(const std::string& topic, double time, const std_msgs::Float64& message);
   /// The next step of the run's schedule (watchdogs first); false when it failed (step_failure_ set).
   bool take_step();
 
@@ -164,8 +162,7 @@ class CartSimNode {
   CartSimParameters parameters_;
   std::unique_ptr<Simulation> simulation_;
   AccuracyGuard accuracy_guard_;  ///< scene `accuracy` + ~accuracy/...; checked at every publish instant
-  std::optional<CommandChannel> steering_channel_;
-  std::optional<CommandChannel> drive_channel_;
+  std::optional<CommandInputs> commands_;  ///< steering_torque, drive_torque: channels, watchdogs, lockstep answers
   std::unique_ptr<BagRecorder> recorder_;
   std::uint64_t run_index_ = 0;  ///< runs recorded so far (a reset starts the next run's bag)
 
@@ -189,8 +186,6 @@ class CartSimNode {
   std::optional<InstantMessages> instant_messages_;  ///< filled in place at each publish instant
   rosgraph_msgs::Clock clock_message_;
   ros::Subscriber clock_subscriber_;  ///< /clock from elsewhere when ~publish_clock is false
-  ros::Subscriber steering_subscriber_;
-  ros::Subscriber drive_subscriber_;
   ros::ServiceServer reset_service_;
   ros::ServiceServer pause_service_;
   ros::ServiceServer set_state_service_;
@@ -221,13 +216,7 @@ class CartSimNode {
   std::optional<std::string> step_failure_;
   std::optional<std::string> record_failure_;
 
-  // Lockstep: topics expected at each publish instant and those answered since it.
-  bool expect_steering_ = false;
-  bool expect_drive_ = false;
-  bool steering_answered_ = false;
-  bool drive_answered_ = false;
-  std::uint64_t lockstep_timeouts_ = 0;
-  std::vector<std::pair<std::string, std_msgs::Float64>> lockstep_records_;  ///< commands to record at the barrier
+  std::uint64_t lockstep_timeouts_ = 0;  ///< lockstep instants that went on without every answer
 
   // Work measurement (wall clock) for integration_error, diagnostics and the summary.
   WallClockPacing::Clock::time_point run_start_wall_;
