@@ -165,14 +165,15 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   pause_service_ = private_node_.advertiseService("pause", &CartSimNode::on_pause, this);
   set_state_service_ = private_node_.advertiseService("set_state", &CartSimNode::on_set_state, this);
   initial_pose_subscriber_ = node_.subscribe("initialpose", 5, &CartSimNode::on_initial_pose, this);
-  {
-    ros::AdvertiseServiceOptions options = ros::AdvertiseServiceOptions::create<StepRun>(
-        "step", [this](StepRun::Request& request, StepRun::Response& response) { return on_step(request, response); },
-        ros::VoidConstPtr(), &step_queue_);
-    step_service_ = private_node_.advertiseService(options);
-    step_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &step_queue_);
-    step_spinner_->start();
-  }
+  step_requests_ = std::make_unique<StepRequests>(
+      private_node_,
+      [this]() -> std::string {
+        if (parameters_.lockstep) return "~lockstep is on: the controllers' answers pace the run";
+        if (parameters_.follow_clock) return "~follow_clock is on: the leader's /clock paces the run";
+        if (!paused_) return "the run is not paused (call ~pause with data: true first)";
+        return "";
+      },
+      [this] { callback_queue_.wake(); });
 
   diagnostic_updater_ = std::make_unique<diagnostic_updater::Updater>(node_, private_node_);
   diagnostic_updater_->setHardwareID("birkhoff_cart/" + simulation_->scene().name);
@@ -225,7 +226,7 @@ bool CartSimNode::take_step() {
     step_failure_ = error.what();
     return false;
   }
-  count_requested_step();
+  step_requests_->count_step(simulation_->state().time);
   ++period_steps_;
   ++total_steps_;
   simulated_time_ += simulation_->state().time - time_before;
@@ -345,7 +346,7 @@ int CartSimNode::run() {
     // closed, exit 4; never std::terminate with the record left unfinished.
     internal_error = error.what();
   }
-  end_step_requests();
+  step_requests_->end(simulation_->state().time);
 
   if (!internal_error && !step_failure_ && !record_failure_ && !stop_requested()) {
     // publish() only queues a message for roscpp's transport threads: give them a moment to send

@@ -16,11 +16,12 @@
 //    there, so a closed loop through another node is the same on every run.
 //
 // Parts with a job of their own are classes: CommandInputs (the command topics, their watchdogs and
-// the lockstep answers), InstantMessages (the messages of a publish instant).
+// the lockstep answers), StepRequests (~step on its own thread), InstantMessages (the messages of a
+// publish instant).
 // The member functions are defined by job: cart_sim_node.cpp (construction and the time loop),
 // cart_sim_pacing.cpp (callbacks, real-time deadlines, the lockstep barrier, following /clock),
 // cart_sim_publishing.cpp, cart_sim_services.cpp (~reset, ~pause, the bag), cart_sim_teleport.cpp
-// (~set_state, /initialpose, ~step), cart_sim_progress.cpp (the fast mode's progress line) and
+// (~set_state, /initialpose), cart_sim_progress.cpp (the fast mode's progress line) and
 // cart_sim_summary.cpp (diagnostics, summary).
 #pragma once
 
@@ -45,7 +46,6 @@
 
 #include "birkhoff_cart/core/accuracy_guard.h"
 #include "birkhoff_cart/SetCartState.h"
-#include "birkhoff_cart/StepRun.h"
 #include "birkhoff_cart/core/sensors/odometry_sensor.h"
 #include "birkhoff_cart/core/simulation.h"
 #include "birkhoff_cart/ros/bag_recorder.h"
@@ -55,6 +55,7 @@
 #include "birkhoff_cart/ros/instant_messages.h"
 #include "birkhoff_cart/ros/shutdown_signals.h"
 #include "birkhoff_cart/ros/signaling_callback_queue.h"
+#include "birkhoff_cart/ros/step_requests.h"
 #include "birkhoff_cart/ros/wall_clock_pacing.h"
 
 namespace birkhoff_cart {
@@ -104,14 +105,8 @@ class CartSimNode {
   /// commands' hold, the accuracy guard, the schedule and the publish instants there; the bag goes
   /// on. False, with `message` naming the problem and nothing changed, when it is refused.
   bool teleport(const CartState& target, const std::string& source, std::string& message);
-  /// Served on its own thread (step_queue_): waits until the run loop has taken the steps.
-  bool on_step(StepRun::Request& request, StepRun::Response& response);
   /// Paused with no ~step request open: the loop waits.
-  bool halted() const { return paused_ && steps_requested_ == 0; }
-  /// After a step: counts it against an open ~step request and wakes its caller when done.
-  void count_requested_step();
-  /// The loop has ended: an open ~step request returns with the steps taken.
-  void end_step_requests();
+  bool halted() const { return paused_ && !step_requests_->open(); }
 
   // cart_sim_node.cpp
   /// Plans the run in the simulation from the current state (Simulation::plan_run; construction,
@@ -190,15 +185,7 @@ class CartSimNode {
   ros::ServiceServer pause_service_;
   ros::ServiceServer set_state_service_;
   ros::Subscriber initial_pose_subscriber_;
-  ros::CallbackQueue step_queue_;  ///< ~step alone: its call blocks until the loop has taken the steps
-  ros::ServiceServer step_service_;
-  std::unique_ptr<ros::AsyncSpinner> step_spinner_;
-  std::mutex step_mutex_;
-  std::condition_variable step_condition_;
-  std::atomic<std::uint64_t> steps_requested_{0};  ///< steps of the open ~step request not yet taken
-  bool step_request_open_ = false;  ///< guarded by step_mutex_
-  bool loop_over_ = false;          ///< guarded by step_mutex_
-  double stepped_to_time_ = 0.0;    ///< scene time after the last requested step [s]; guarded by step_mutex_
+  std::unique_ptr<StepRequests> step_requests_;  ///< ~step, on a thread of its own
   std::unique_ptr<diagnostic_updater::Updater> diagnostic_updater_;
 
   double run_duration_ = 0.0;             ///< T: the run's length from its start [s]; +inf = without end
