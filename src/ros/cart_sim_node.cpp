@@ -119,7 +119,7 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   // The record comes first: a node that cannot keep its record does not run at all.
   if (!parameters_.bag_path.empty()) {
     try {
-      open_record(parameters_.bag_path);
+      record_.emplace(parameters_.bag_path, parameters_.bag_compression, parameters_.min_free_disk_space);
     } catch (const std::exception& error) {
       throw NodeStartupError(std::string("cannot record (~bag_path): ") + error.what());
     }
@@ -194,7 +194,7 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
            parameters_.frames.base_link.c_str(),
            parameters_.publish_clock ? "publishing /clock"
                                      : (parameters_.follow_clock ? "following /clock" : "not publishing /clock"),
-           recorder_ ? ", recording to " : "", recorder_ ? recorder_->path().c_str() : "");
+           record_ ? ", recording to " : "", record_ ? record_->bag().path().c_str() : "");
 }
 
 CartSimNode::~CartSimNode() = default;
@@ -251,7 +251,7 @@ int CartSimNode::run_loop(std::string& outcome) {
       outcome = "interrupted (shutdown requested)";
       break;
     }
-    if (record_failure_) break;  // a command could not be recorded (set in a callback, also while paused)
+    if (record_failed()) break;  // a command could not be recorded (set in a callback, also while paused)
     if (halted()) {
       wait_while_paused();
       continue;
@@ -265,7 +265,7 @@ int CartSimNode::run_loop(std::string& outcome) {
     if (parameters_.follow_clock) {  // the batch runs once the leader's /clock has reached its end
       const std::uint64_t resets_before = resets_;
       wait_for_clock(std::min(instant, end_time_));
-      if (halted() || record_failure_ || stop_requested() || resets_ != resets_before) continue;
+      if (halted() || record_failed() || stop_requested() || resets_ != resets_before) continue;
     }
     Clock::time_point batch_start = Clock::now();
     bool failed = false;
@@ -291,7 +291,7 @@ int CartSimNode::run_loop(std::string& outcome) {
       if ((!step_due || !paced) && !parameters_.lockstep && callback_queue_.pending()) {
         const std::uint64_t resets_before = resets_;
         process_callbacks();
-        if (halted() || record_failure_ || stop_requested() || resets_ != resets_before) {
+        if (halted() || record_failed() || stop_requested() || resets_ != resets_before) {
           interrupted = true;  // paused, failed, stopping, reset or teleported: a new batch
           break;
         }
@@ -303,7 +303,7 @@ int CartSimNode::run_loop(std::string& outcome) {
         period_stepping_wall_time_ += elapsed;
         wait_until_due(std::min(instant, end_time_));
         batch_start = Clock::now();
-        if (halted() || record_failure_ || stop_requested()) {
+        if (halted() || record_failed() || stop_requested()) {
           interrupted = true;
           break;
         }
@@ -325,7 +325,7 @@ int CartSimNode::run_loop(std::string& outcome) {
     if (instant_due || simulation_->at_end()) {
       publish_clock(time);
       publish_instant();
-      if (record_failure_) break;
+      if (record_failed()) break;
       if (parameters_.lockstep) wait_for_commands(time);
       if (parameters_.fast) report_progress();
     }
@@ -348,7 +348,7 @@ int CartSimNode::run() {
   }
   step_requests_->end(simulation_->state().time);
 
-  if (!internal_error && !step_failure_ && !record_failure_ && !stop_requested()) {
+  if (!internal_error && !step_failure_ && !record_failed() && !stop_requested()) {
     // publish() only queues a message for roscpp's transport threads: give them a moment to send
     // the last instant (subscribers lost the last /tf when the node left at once).
     ros::WallDuration(kLastInstantLinger).sleep();
@@ -363,39 +363,26 @@ int CartSimNode::run() {
               internal_error->c_str());
     outcome = "internal error: " + *internal_error;
   }
-  if (record_failure_) {
+  if (record_failed()) {
     ROS_ERROR("cart_sim: bag write failed at t = %.9g s, stopping (the node does not run without its record): %s",
-              simulation_->state().time, record_failure_->c_str());
+              simulation_->state().time, record_->failure()->c_str());
   }
-  finish_record();
-  if (record_failure_) {
-    ROS_FATAL("cart_sim: the record failed: %s", record_failure_->c_str());
-    outcome = "record failure: " + *record_failure_;
+  if (record_) record_->finish();
+  if (record_failed()) {
+    ROS_FATAL("cart_sim: the record failed: %s", record_->failure()->c_str());
+    outcome = "record failure: " + *record_->failure();
   }
   write_summary(outcome);
   if (internal_error) return kExitInternalError;
   if (step_failure_) return kExitStepFailure;
-  if (record_failure_) return kExitRecordFailure;
+  if (record_failed()) return kExitRecordFailure;
   return kExitFinished;
 }
 
-void CartSimNode::finish_record() {
-  if (!recorder_) return;
-  try {
-    recorder_->close();
-  } catch (const std::exception& error) {
-    // Keep the first cause (the failed write); the close failure follows it.
-    record_failure_ = record_failure_ ? *record_failure_ + "; then " + error.what() : std::string(error.what());
-  }
+void CartSimNode::record_command(const std::string& topic, double time, const std_msgs::Float64& message) {
+  if (record_) record_->write(topic, ros_conversions::to_ros_time(time), message);
 }
 
-void CartSimNode::record_command(const std::string& topic, double time, const std_msgs::Float64& message) {
-  if (!recorder_ || record_failure_) return;
-  try {
-    recorder_->write(topic, ros_conversions::to_ros_time(time), message);
-  } catch (const std::exception& failure) {
-    record_failure_ = failure.what();
-  }
-}
+bool CartSimNode::record_failed() const { return record_ && record_->failure(); }
 
 }  // namespace birkhoff_cart

@@ -56,23 +56,17 @@ void CartSimNode::publish_instant() {
     last_transform_stamp_ = stamp;
   }
   ++published_instants_;
-  if (recorder_ && !record_failure_) {
+  if (record_) {
     IntegrationError& error = messages.integration_error;
     if (!parameters_.record_wall_time) error.wall_time_per_step = 0.0;  // the one field that differs between runs
-    try {
-      recorder_->write(integration_error_topic_, error.header.stamp, error);
-      if (!world_transform_recorded_) {  // once per bag, so that a replay has the world frame
-        recorder_->write("/tf_static", stamp, world_transform_);
-        world_transform_recorded_ = true;
-      }
-      // Without a sensor ground_truth equals odom (pose and twist): the bag keeps odom only.
-      if (odometry_sensor_) recorder_->write(ground_truth_topic_, stamp, messages.ground_truth);
-      recorder_->write(odometry_topic_, stamp, messages.odometry);
-      recorder_->write(joint_state_topic_, messages.joints.header.stamp, messages.joints);
-      if (transform_sent) recorder_->write(kTransformTopic, stamp, messages.transforms);
-    } catch (const std::exception& failure) {
-      record_failure_ = failure.what();
-    }
+    record_->write(integration_error_topic_, error.header.stamp, error);
+    // Once per bag, so that a replay has the world frame.
+    if (record_->take_first_instant()) record_->write("/tf_static", stamp, world_transform_);
+    // Without a sensor ground_truth equals odom (pose and twist): the bag keeps odom only.
+    if (odometry_sensor_) record_->write(ground_truth_topic_, stamp, messages.ground_truth);
+    record_->write(odometry_topic_, stamp, messages.odometry);
+    record_->write(joint_state_topic_, messages.joints.header.stamp, messages.joints);
+    if (transform_sent) record_->write(kTransformTopic, stamp, messages.transforms);
   }
   if (pass_due_instants(simulation_->scene().initial_state.time, parameters_.diagnostic_period, simulation_->state().time,
                         0.5 * simulation_->step_size(), next_diagnostic_index_)) {

@@ -1,4 +1,4 @@
-// cart_sim's ~reset and ~pause services and the bag of each run (see cart_sim_node.h).
+// cart_sim's ~reset and ~pause services (see cart_sim_node.h).
 #include "birkhoff_cart/ros/cart_sim_node.h"
 
 #include <algorithm>
@@ -14,31 +14,11 @@ bool CartSimNode::on_reset(std_srvs::Empty::Request& /*request*/, std_srvs::Empt
   restart_schedule();
   // Each run gets its own bag: one bag across a reset would hold overlapping times of two runs,
   // which playback interleaves.
-  if (recorder_ && !record_failure_) {
-    try {
-      recorder_->close();
-      ROS_INFO("cart_sim: run %lu recorded to %s", static_cast<unsigned long>(run_index_), recorder_->path().c_str());
-      open_record(parameters_.bag_path);
-    } catch (const std::exception& failure) {
-      record_failure_ = std::string("at ~reset: ") + failure.what();
-    }
-  }
+  if (record_) record_->next_run();
   ROS_INFO("cart_sim: reset to the scene's initial state at t = %.6g s%s%s", start_time,
-           recorder_ && !record_failure_ ? ", recording to " : "",
-           recorder_ && !record_failure_ ? recorder_->path().c_str() : "");
+           record_ && !record_->failure() ? ", recording to " : "",
+           record_ && !record_->failure() ? record_->bag().path().c_str() : "");
   return true;
-}
-
-void CartSimNode::open_record(const std::string& path) {
-  ++run_index_;
-  world_transform_recorded_ = false;
-  recorder_ = std::make_unique<BagRecorder>(run_bag_path(path, run_index_),
-                                            BagRecorder::parse_compression(parameters_.bag_compression),
-                                            parameters_.min_free_disk_space);
-  if (!recorder_->earlier_bag_kept_as().empty()) {
-    ROS_WARN("cart_sim: %s already held a bag: kept it as %s (a record never overwrites one)",
-             recorder_->path().c_str(), recorder_->earlier_bag_kept_as().c_str());
-  }
 }
 
 bool CartSimNode::on_pause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response) {

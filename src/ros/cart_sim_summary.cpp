@@ -124,10 +124,10 @@ void CartSimNode::write_summary(const std::string& outcome) {
   if (odometry_sensor_ && odometry_sensor_->estimate().time == state.time) {  // read at the last instant
     text << " " << odometry_drift_line(*odometry_sensor_, state, simulation_->model()) << ".";
   }
-  if (recorder_) {
-    text << " Bag: " << recorder_->current_path() << (record_failure_ ? " (unfinished; " : " (");
+  if (record_) {
+    text << " Bag: " << record_->bag().current_path() << (record_->failure() ? " (unfinished; " : " (");
     bool first = true;
-    for (const auto& [topic, count] : recorder_->message_counts()) {
+    for (const auto& [topic, count] : record_->bag().message_counts()) {
       text << (first ? "" : ", ") << topic << ": " << count;
       first = false;
     }

@@ -45,7 +45,7 @@ bool CartSimNode::teleport(const CartState& target, const std::string& source, s
   text << source << ": teleported at t = " << format_seconds(time) << " s to base_link (" << base.x() << ", "
        << base.y() << ") m, heading " << target.heading << " rad, steering angle " << target.steering_angle
        << " rad, forward speed " << target.forward_speed << " m/s, steering rate " << target.steering_rate
-       << " rad/s (a restart of the run from there" << (recorder_ ? "; the bag goes on)" : ")");
+       << " rad/s (a restart of the run from there" << (record_ ? "; the bag goes on)" : ")");
   message = text.str();
   ROS_INFO("cart_sim: %s", message.c_str());
   return true;

@@ -16,8 +16,8 @@
 //    there, so a closed loop through another node is the same on every run.
 //
 // Parts with a job of their own are classes: CommandInputs (the command topics, their watchdogs and
-// the lockstep answers), StepRequests (~step on its own thread), InstantMessages (the messages of a
-// publish instant).
+// the lockstep answers), StepRequests (~step on its own thread), RunRecord (the bag of each run and
+// its failure), InstantMessages (the messages of a publish instant).
 // The member functions are defined by job: cart_sim_node.cpp (construction and the time loop),
 // cart_sim_pacing.cpp (callbacks, real-time deadlines, the lockstep barrier, following /clock),
 // cart_sim_publishing.cpp, cart_sim_services.cpp (~reset, ~pause, the bag), cart_sim_teleport.cpp
@@ -48,7 +48,7 @@
 #include "birkhoff_cart/SetCartState.h"
 #include "birkhoff_cart/core/sensors/odometry_sensor.h"
 #include "birkhoff_cart/core/simulation.h"
-#include "birkhoff_cart/ros/bag_recorder.h"
+#include "birkhoff_cart/ros/run_record.h"
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
 #include "birkhoff_cart/ros/command_inputs.h"
 #include "birkhoff_cart/ros/conversions.h"
@@ -91,12 +91,12 @@ class CartSimNode {
 
  private:
   int run_loop(std::string& outcome);
-  void finish_record();
+  /// The record has failed (the node stops: it does not run without its record).
+  bool record_failed() const;
 
   // cart_sim_services.cpp
   bool on_reset(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   bool on_pause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
-  void open_record(const std::string& path);
 
   // cart_sim_teleport.cpp
   bool on_set_state(SetCartState::Request& request, SetCartState::Response& response);
@@ -158,8 +158,7 @@ class CartSimNode {
   std::unique_ptr<Simulation> simulation_;
   AccuracyGuard accuracy_guard_;  ///< scene `accuracy` + ~accuracy/...; checked at every publish instant
   std::optional<CommandInputs> commands_;  ///< steering_torque, drive_torque: channels, watchdogs, lockstep answers
-  std::unique_ptr<BagRecorder> recorder_;
-  std::uint64_t run_index_ = 0;  ///< runs recorded so far (a reset starts the next run's bag)
+  std::optional<RunRecord> record_;  ///< the bag of each run; none without ~bag_path
 
   ros::Publisher odometry_publisher_;
   ros::Publisher ground_truth_publisher_;
@@ -172,7 +171,6 @@ class CartSimNode {
   std::string odometry_topic_;
   std::string ground_truth_topic_;
   tf2_msgs::TFMessage world_transform_;  ///< world → odom, published once and recorded into each bag
-  bool world_transform_recorded_ = false;  ///< into the current bag
   /// The scene's odometry sensor (docs/odometry_sensor.md); none: odom is the exact state.
   std::optional<OdometrySensor> odometry_sensor_;
   std::string joint_state_topic_;
@@ -201,7 +199,6 @@ class CartSimNode {
   std::uint64_t resets_ = 0;              ///< ~reset calls served
   ros::Time last_transform_stamp_;        ///< never the same tf stamp twice
   std::optional<std::string> step_failure_;
-  std::optional<std::string> record_failure_;
 
   std::uint64_t lockstep_timeouts_ = 0;  ///< lockstep instants that went on without every answer
 
