@@ -227,9 +227,7 @@ bool CartSimNode::take_step() {
     return false;
   }
   step_requests_->count_step(simulation_->state().time);
-  ++period_steps_;
-  ++total_steps_;
-  simulated_time_ += simulation_->state().time - time_before;
+  work_.count_step(simulation_->state().time - time_before);
   if (!clock_started_) {  // the first /clock, t0 + h, unless that is a publish instant or the end (published there)
     clock_started_ = true;
     const double start = simulation_->scene().initial_state.time;
@@ -298,9 +296,7 @@ int CartSimNode::run_loop(std::string& outcome) {
         if (!step_due) continue;
       }
       if (!step_due) {
-        const double elapsed = std::chrono::duration<double>(Clock::now() - batch_start).count();
-        stepping_wall_time_ += elapsed;
-        period_stepping_wall_time_ += elapsed;
+        work_.add_stepping(std::chrono::duration<double>(Clock::now() - batch_start).count());
         wait_until_due(std::min(instant, end_time_));
         batch_start = Clock::now();
         if (halted() || record_failed() || stop_requested()) {
@@ -314,9 +310,7 @@ int CartSimNode::run_loop(std::string& outcome) {
         break;
       }
     }
-    const double batch_wall_time = std::chrono::duration<double>(Clock::now() - batch_start).count();
-    stepping_wall_time_ += batch_wall_time;
-    period_stepping_wall_time_ += batch_wall_time;
+    work_.add_stepping(std::chrono::duration<double>(Clock::now() - batch_start).count());
     if (failed) break;
     if (interrupted) continue;
     const double time = simulation_->state().time;
@@ -335,8 +329,9 @@ int CartSimNode::run_loop(std::string& outcome) {
 
 int CartSimNode::run() {
   if (parameters_.lockstep) wait_for_controllers();
-  run_start_wall_ = WallClockPacing::Clock::now();
-  pacing_.restart(run_start_wall_, simulation_->state().time);
+  const WallClockPacing::Clock::time_point run_start = WallClockPacing::Clock::now();
+  work_.start(run_start, simulation_->state().time);
+  pacing_.restart(run_start, simulation_->state().time);
   std::string outcome = "finished";
   std::optional<std::string> internal_error;
   try {

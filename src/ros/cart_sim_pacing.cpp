@@ -43,7 +43,7 @@ void CartSimNode::wait_while_paused() {
   const Clock::time_point start = Clock::now();
   callback_queue_.wait_until(after(kLongestSleep));
   process_callbacks();
-  paused_wall_time_ += std::chrono::duration<double>(Clock::now() - start).count();
+  work_.add_paused(std::chrono::duration<double>(Clock::now() - start).count());
   // Scene time stood still: the next deadline starts from now.
   pacing_.restart(Clock::now(), simulation_->state().time);
 }

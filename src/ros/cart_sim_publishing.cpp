@@ -33,15 +33,13 @@ void CartSimNode::publish_instant() {
   // once they hold their strings. roscpp 1.15's typed publish() still builds a std::string of the
   // md5sum at every call (ros/publisher.h), and serializes into a buffer of its own for a topic
   // with subscribers.
-  last_wall_time_per_step_ = period_steps_ > 0 ? period_stepping_wall_time_ / static_cast<double>(period_steps_) : 0.0;
-  period_stepping_wall_time_ = 0.0;
-  period_steps_ = 0;
+  const double wall_time_per_step = work_.end_period();  // [s]
   InstantMessages& messages = *instant_messages_;
   const OdometryEstimate* estimate = odometry_sensor_ ? &odometry_sensor_->read(simulation_->state()) : nullptr;
   // The accuracy guard is judged here, once per instant, before the messages are filled from it.
   const Diagnostics diagnostics = simulation_->diagnostics();
   accuracy_guard_.check(simulation_->state().time, diagnostics, simulation_->statistics());
-  messages.fill(*simulation_, diagnostics, accuracy_guard_, last_wall_time_per_step_, estimate);
+  messages.fill(*simulation_, diagnostics, accuracy_guard_, wall_time_per_step, estimate);
 
   // The controllers' inputs as shared messages (zero-copy in a nodelet manager).
   publish_shared(ground_truth_publisher_, messages.ground_truth);
@@ -55,7 +53,6 @@ void CartSimNode::publish_instant() {
     transform_publisher_.publish(messages.transforms);
     last_transform_stamp_ = stamp;
   }
-  ++published_instants_;
   if (record_) {
     IntegrationError& error = messages.integration_error;
     if (!parameters_.record_wall_time) error.wall_time_per_step = 0.0;  // the one field that differs between runs

@@ -26,7 +26,7 @@ std::string exact_text(double value) {
 
 void CartSimNode::produce_diagnostics(diagnostic_updater::DiagnosticStatusWrapper& status) {
   const Diagnostics diagnostics = simulation_->diagnostics();
-  const double real_time_factor = this->real_time_factor();
+  const double real_time_factor = work_.real_time_factor(WallClockPacing::Clock::now());
 
   // One threshold system: the level is the accuracy guard's (ros_accuracy::report below), raised
   // by rejected commands and a failed step.
@@ -51,7 +51,7 @@ void CartSimNode::produce_diagnostics(diagnostic_updater::DiagnosticStatusWrappe
   status.add("steps taken", simulation_->statistics().steps);
   status.add("paused", paused_);
   status.add("real-time factor [-]", real_time_factor);
-  status.add("step cost [s]", last_wall_time_per_step_);
+  status.add("step cost [s]", work_.last_wall_time_per_step());
   status.add("energy T* [J]", diagnostics.energy);
   status.add("energy-balance residual [J]", diagnostics.energy_balance_residual);
   status.add("p2-balance residual [N m s]", diagnostics.p2_balance_residual);
@@ -87,11 +87,6 @@ void CartSimNode::produce_diagnostics(diagnostic_updater::DiagnosticStatusWrappe
   }
 }
 
-double CartSimNode::real_time_factor(WallClockPacing::Clock::time_point now) const {
-  const double running_wall_time = std::chrono::duration<double>(now - run_start_wall_).count() - paused_wall_time_;
-  return running_wall_time > 0.0 ? simulated_time_ / running_wall_time : 0.0;
-}
-
 void CartSimNode::write_summary(const std::string& outcome) {
   const CartState& state = simulation_->state();
   const Diagnostics diagnostics = simulation_->diagnostics();
@@ -99,7 +94,7 @@ void CartSimNode::write_summary(const std::string& outcome) {
   // One clock reading for the wall time and the real-time factor, so the summary's numbers agree
   // with each other (two readings drifted apart by more than 1e-3 of a short run under load).
   const WallClockPacing::Clock::time_point now = WallClockPacing::Clock::now();
-  const double wall_time = std::chrono::duration<double>(now - run_start_wall_).count();
+  const double wall_time = work_.wall_time(now);  // [s]
   std::ostringstream text;
   text << std::setprecision(9);
   text << "cart_sim summary: " << outcome << ". Scene '" << simulation_->scene().name << "', integrator "
@@ -112,11 +107,11 @@ void CartSimNode::write_summary(const std::string& outcome) {
   if (diagnostics.has_reference) {
     text << ", reference position error = " << diagnostics.reference_position_error << " m";
   }
-  text << ". Steps: " << total_steps_ << " (" << simulation_->statistics().newton_iterations_total
+  text << ". Steps: " << work_.steps() << " (" << simulation_->statistics().newton_iterations_total
        << " Newton iterations since the last start), wall time " << wall_time << " s (stepping "
-       << stepping_wall_time_ << " s, paused " << paused_wall_time_
-       << " s), real-time factor " << real_time_factor(now)
-       << ". Published instants: " << published_instants_ << "."
+       << work_.stepping_wall_time() << " s, paused " << work_.paused_wall_time()
+       << " s), real-time factor " << work_.real_time_factor(now)
+       << ". Published instants: " << work_.published_instants() << "."
        << ros_accuracy::summary_sentence(accuracy_guard_, simulation_->statistics(), simulation_->integrator_name());
   const std::string control = step_control_summary(simulation_->scene().integrator, simulation_->statistics());
   if (!control.empty()) text << " Step size: the output step h; " << control << ".";

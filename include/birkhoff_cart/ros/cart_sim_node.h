@@ -17,7 +17,8 @@
 //
 // Parts with a job of their own are classes: CommandInputs (the command topics, their watchdogs and
 // the lockstep answers), StepRequests (~step on its own thread), RunRecord (the bag of each run and
-// its failure), InstantMessages (the messages of a publish instant).
+// its failure), RunWorkMeter (what the run costs in wall time), InstantMessages (the messages of a
+// publish instant).
 // The member functions are defined by job: cart_sim_node.cpp (construction and the time loop),
 // cart_sim_pacing.cpp (callbacks, real-time deadlines, the lockstep barrier, following /clock),
 // cart_sim_publishing.cpp, cart_sim_services.cpp (~reset, ~pause, the bag), cart_sim_teleport.cpp
@@ -49,6 +50,7 @@
 #include "birkhoff_cart/core/sensors/odometry_sensor.h"
 #include "birkhoff_cart/core/simulation.h"
 #include "birkhoff_cart/ros/run_record.h"
+#include "birkhoff_cart/ros/run_work_meter.h"
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
 #include "birkhoff_cart/ros/command_inputs.h"
 #include "birkhoff_cart/ros/conversions.h"
@@ -148,8 +150,6 @@ class CartSimNode {
   // cart_sim_summary.cpp
   void produce_diagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
   void write_summary(const std::string& outcome);
-  /// Real-time factor over the run until `now`: scene time advanced / wall time not paused [-].
-  double real_time_factor(WallClockPacing::Clock::time_point now = WallClockPacing::Clock::now()) const;
 
   ros::NodeHandle node_;
   ros::NodeHandle private_node_;
@@ -202,18 +202,7 @@ class CartSimNode {
 
   std::uint64_t lockstep_timeouts_ = 0;  ///< lockstep instants that went on without every answer
 
-  // Work measurement (wall clock) for integration_error, diagnostics and the summary.
-  WallClockPacing::Clock::time_point run_start_wall_;
-  std::optional<WallClockPacing::Clock::time_point> last_progress_wall_;  ///< the last progress line (or the start)
-  double last_progress_time_ = 0.0;           ///< the scene time it reported then [s]
-  double paused_wall_time_ = 0.0;             ///< wall time spent paused [s]
-  double stepping_wall_time_ = 0.0;           ///< wall time spent in step batches since the start [s]
-  double period_stepping_wall_time_ = 0.0;    ///< ... since the last publish instant [s]
-  std::uint64_t period_steps_ = 0;
-  double last_wall_time_per_step_ = 0.0;      ///< [s]
-  std::uint64_t total_steps_ = 0;             ///< steps over the whole run, resets included
-  double simulated_time_ = 0.0;               ///< scene time advanced over the whole run [s]
-  std::uint64_t published_instants_ = 0;
+  RunWorkMeter work_;  ///< wall time of the run: integration_error, diagnostics, progress, summary
   std::uint64_t diagnostics_rejections_seen_ = 0;
 };
 
