@@ -128,36 +128,13 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   // Every subscription and service of the node goes through callback_queue_.
   node_.setCallbackQueue(&callback_queue_);
   private_node_.setCallbackQueue(&callback_queue_);
-  odometry_publisher_ = node_.advertise<nav_msgs::Odometry>("odom", 50);
-  ground_truth_publisher_ = node_.advertise<nav_msgs::Odometry>("ground_truth", 50);
-  joint_state_publisher_ = node_.advertise<sensor_msgs::JointState>("joint_states", 50);
-  integration_error_publisher_ = private_node_.advertise<IntegrationError>("integration_error", 50);
-  // /clock through a NodeHandle whose own remapping keeps it /clock: main() remaps roscpp's internal
-  // /clock subscription of this process away (kUnheardClockTopic), so the node does not hear back
-  // every /clock it publishes; it sets its own ROS time instead (publish_clock()). Without
-  // ~publish_clock it hears /clock from the clock source as any node does.
-  ros::NodeHandle clock_node(node_, "", ros::M_string{{"/clock", "/clock"}});
-  if (parameters_.publish_clock) {
-    clock_publisher_ = clock_node.advertise<rosgraph_msgs::Clock>("/clock", 10);
-  } else if (ros::Time::isSimTime()) {
+  publisher_.emplace(node_, private_node_, parameters_, simulation_->scene().initial_state.time);
+  // Without ~publish_clock the node hears /clock from the clock source as any node does (main()
+  // moved roscpp's own subscription away: see InstantPublisher).
+  if (!parameters_.publish_clock && ros::Time::isSimTime()) {
+    ros::NodeHandle clock_node(node_, "", ros::M_string{{"/clock", "/clock"}});
     clock_subscriber_ = clock_node.subscribe("/clock", 1, &hear_clock);
   }
-  // /tf through a publisher of our own rather than tf2_ros::TransformBroadcaster, whose
-  // sendTransform() builds a new TFMessage (a vector) at every call; same topic and queue.
-  if (parameters_.publish_tf) transform_publisher_ = ros::NodeHandle().advertise<tf2_msgs::TFMessage>(kTransformTopic, 100);
-  odometry_topic_ = odometry_publisher_.getTopic();
-  ground_truth_topic_ = ground_truth_publisher_.getTopic();
-  // REP-105: the world frame (map) is the ground truth's; the odometry starts at the true pose, so
-  // world → odom is the identity, latched on /tf_static once (docs/odometry_sensor.md, "Frames").
-  world_transform_.transforms.push_back(
-      ros_conversions::world_to_odom_transform(parameters_.frames, simulation_->scene().initial_state.time));
-  if (parameters_.publish_tf && parameters_.publish_world_tf) {
-    static_transform_publisher_ = ros::NodeHandle().advertise<tf2_msgs::TFMessage>("/tf_static", 10, true);
-    static_transform_publisher_.publish(world_transform_);
-  }
-  joint_state_topic_ = joint_state_publisher_.getTopic();
-  integration_error_topic_ = integration_error_publisher_.getTopic();
-  instant_messages_.emplace(parameters_.frames, parameters_.odometry_covariance);
   commands_->subscribe(node_, [this](const std::string& topic, double time, const std_msgs::Float64& message) {
     record_command(topic, time, message);
   });
@@ -210,7 +187,7 @@ void CartSimNode::restart_schedule() {
   next_publish_index_ = 1;
   next_diagnostic_index_ = 1;
   clock_started_ = false;
-  last_transform_stamp_ = ros::Time();
+  publisher_->restart();
   pacing_.restart(WallClockPacing::Clock::now(), start_time);
 }
 
@@ -234,7 +211,7 @@ bool CartSimNode::take_step() {
     const double time = simulation_->state().time;
     if (!simulation_->at_end() &&
         start + static_cast<double>(next_publish_index_) * publish_period_ > time + 0.5 * simulation_->step_size()) {
-      publish_clock(time);
+      publisher_->publish_clock(time);
     }
   }
   return true;
@@ -317,7 +294,7 @@ int CartSimNode::run_loop(std::string& outcome) {
     // The publish instants due by now, and the run's end t0 + T (an instant or not), published once.
     const bool instant_due = pass_due_instants(start, publish_period_, time, half_step, next_publish_index_);
     if (instant_due || simulation_->at_end()) {
-      publish_clock(time);
+      publisher_->publish_clock(time);
       publish_instant();
       if (record_failed()) break;
       if (parameters_.lockstep) wait_for_commands(time);

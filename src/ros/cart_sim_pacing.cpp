@@ -50,7 +50,7 @@ void CartSimNode::wait_while_paused() {
 
 void CartSimNode::wait_for_controllers() {
   const auto connected = [this] {
-    return commands_->controllers_connected() && joint_state_publisher_.getNumSubscribers() > 0;
+    return commands_->controllers_connected() && publisher_->joint_state_subscribers() > 0;
   };
   Clock::time_point next_note = after(parameters_.lockstep_timeout);
   while (!connected() && !stop_requested()) {

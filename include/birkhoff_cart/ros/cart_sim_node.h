@@ -17,8 +17,8 @@
 //
 // Parts with a job of their own are classes: CommandInputs (the command topics, their watchdogs and
 // the lockstep answers), StepRequests (~step on its own thread), RunRecord (the bag of each run and
-// its failure), RunWorkMeter (what the run costs in wall time), InstantMessages (the messages of a
-// publish instant).
+// its failure), RunWorkMeter (what the run costs in wall time), InstantPublisher (the topics of a
+// publish instant, /clock and tf, and what of them goes into the bag).
 // The member functions are defined by job: cart_sim_node.cpp (construction and the time loop),
 // cart_sim_pacing.cpp (callbacks, real-time deadlines, the lockstep barrier, following /clock),
 // cart_sim_publishing.cpp, cart_sim_services.cpp (~reset, ~pause, the bag), cart_sim_teleport.cpp
@@ -54,7 +54,7 @@
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
 #include "birkhoff_cart/ros/command_inputs.h"
 #include "birkhoff_cart/ros/conversions.h"
-#include "birkhoff_cart/ros/instant_messages.h"
+#include "birkhoff_cart/ros/instant_publisher.h"
 #include "birkhoff_cart/ros/shutdown_signals.h"
 #include "birkhoff_cart/ros/signaling_callback_queue.h"
 #include "birkhoff_cart/ros/step_requests.h"
@@ -121,7 +121,7 @@ class CartSimNode {
   bool take_step();
 
   // cart_sim_publishing.cpp
-  void publish_clock(double time);
+  /// One publish instant: the guard checked, the state published and recorded, /diagnostics when due.
   void publish_instant();
 
   // cart_sim_pacing.cpp
@@ -160,24 +160,9 @@ class CartSimNode {
   std::optional<CommandInputs> commands_;  ///< steering_torque, drive_torque: channels, watchdogs, lockstep answers
   std::optional<RunRecord> record_;  ///< the bag of each run; none without ~bag_path
 
-  ros::Publisher odometry_publisher_;
-  ros::Publisher ground_truth_publisher_;
-  ros::Publisher static_transform_publisher_;  ///< /tf_static, latched: the identity world → odom
-  ros::Publisher joint_state_publisher_;
-  ros::Publisher integration_error_publisher_;
-  ros::Publisher clock_publisher_;
-  ros::Publisher transform_publisher_;  ///< /tf (tf2_msgs/TFMessage), as tf2_ros::TransformBroadcaster advertises it
-  /// The topics as recorded in the bag (resolved names, kept: Publisher::getTopic() returns a copy).
-  std::string odometry_topic_;
-  std::string ground_truth_topic_;
-  tf2_msgs::TFMessage world_transform_;  ///< world → odom, published once and recorded into each bag
+  std::optional<InstantPublisher> publisher_;  ///< the topics of a publish instant, /clock, tf
   /// The scene's odometry sensor (docs/odometry_sensor.md); none: odom is the exact state.
   std::optional<OdometrySensor> odometry_sensor_;
-  std::string joint_state_topic_;
-  std::string integration_error_topic_;
-  static constexpr const char* kTransformTopic = "/tf";
-  std::optional<InstantMessages> instant_messages_;  ///< filled in place at each publish instant
-  rosgraph_msgs::Clock clock_message_;
   ros::Subscriber clock_subscriber_;  ///< /clock from elsewhere when ~publish_clock is false
   ros::ServiceServer reset_service_;
   ros::ServiceServer pause_service_;
@@ -197,7 +182,6 @@ class CartSimNode {
   std::atomic<bool> paused_{false};  ///< read by the ~step thread
   std::atomic<bool> stop_flag_{false};  ///< request_stop()
   std::uint64_t resets_ = 0;              ///< ~reset calls served
-  ros::Time last_transform_stamp_;        ///< never the same tf stamp twice
   std::optional<std::string> step_failure_;
 
   std::uint64_t lockstep_timeouts_ = 0;  ///< lockstep instants that went on without every answer

@@ -1,0 +1,66 @@
+// cart_sim's outputs at a publish instant (docs/ros_interface.md, "Topics"): odom, ground_truth,
+// joint_states, ~integration_error, odom → base_link on /tf (once per stamp), /clock, and the
+// identity world → odom latched on /tf_static; the same messages into the run's bag. The messages
+// are InstantMessages filled in place, so an instant allocates nothing here; the controllers' inputs
+// go out as shared messages (zero-copy to a nodelet in the same manager). Part of CartSimNode.
+#pragma once
+
+#include <string>
+
+#include <ros/ros.h>
+#include <rosgraph_msgs/Clock.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include "birkhoff_cart/core/accuracy_guard.h"
+#include "birkhoff_cart/core/sensors/odometry_sensor.h"
+#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/ros/cart_sim_parameters.h"
+#include "birkhoff_cart/ros/instant_messages.h"
+#include "birkhoff_cart/ros/run_record.h"
+
+namespace birkhoff_cart {
+
+class InstantPublisher {
+ public:
+  /// Advertises the topics (`node`: odom, ground_truth, joint_states; `private_node`:
+  /// integration_error; /clock with ~publish_clock, /tf with ~publish_tf) and latches world → odom
+  /// stamped `start_time` [s] (with ~publish_tf and ~publish_world_tf).
+  InstantPublisher(ros::NodeHandle& node, ros::NodeHandle& private_node, const CartSimParameters& parameters,
+                   double start_time);
+
+  /// /clock at scene time `time` [s] (with ~publish_clock), and this process's ROS time with it.
+  void publish_clock(double time);
+  /// One publish instant of `simulation`: its `diagnostics` and the `guard` checked with them,
+  /// `wall_time_per_step` [s], the odometry sensor's `estimate` (none: odom is the exact state);
+  /// into `record` too when there is one (ground_truth only beside a sensor's odom).
+  void publish(const Simulation& simulation, const Diagnostics& diagnostics, const AccuracyGuard& guard,
+               double wall_time_per_step, const OdometryEstimate* estimate, RunRecord* record);
+  /// A new run (~reset, a teleport): its first instant sends /tf even at a stamp sent before.
+  void restart() { last_transform_stamp_ = ros::Time(); }
+
+  /// Subscribers of joint_states (lockstep waits for its controller).
+  std::uint32_t joint_state_subscribers() const { return joint_state_publisher_.getNumSubscribers(); }
+
+ private:
+  static constexpr const char* kTransformTopic = "/tf";
+
+  const CartSimParameters& parameters_;
+  ros::Publisher odometry_publisher_;
+  ros::Publisher ground_truth_publisher_;
+  ros::Publisher joint_state_publisher_;
+  ros::Publisher integration_error_publisher_;
+  ros::Publisher clock_publisher_;
+  ros::Publisher transform_publisher_;         ///< /tf (tf2_msgs/TFMessage), as tf2_ros::TransformBroadcaster advertises it
+  ros::Publisher static_transform_publisher_;  ///< /tf_static, latched: the identity world → odom
+  /// The topics as recorded in the bag (resolved names, kept: Publisher::getTopic() returns a copy).
+  std::string odometry_topic_;
+  std::string ground_truth_topic_;
+  std::string joint_state_topic_;
+  std::string integration_error_topic_;
+  tf2_msgs::TFMessage world_transform_;  ///< world → odom, published once and recorded into each bag
+  InstantMessages messages_;             ///< filled in place at each publish instant
+  rosgraph_msgs::Clock clock_message_;
+  ros::Time last_transform_stamp_;  ///< never the same tf stamp twice
+};
+
+}  // namespace birkhoff_cart
