@@ -152,9 +152,9 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
       },
       [this] { callback_queue_.wake(); });
 
-  diagnostic_updater_ = std::make_unique<diagnostic_updater::Updater>(node_, private_node_);
-  diagnostic_updater_->setHardwareID("birkhoff_cart/" + simulation_->scene().name);
-  diagnostic_updater_->add("simulation", this, &CartSimNode::produce_diagnostics);
+  reports_.emplace(RunView{parameters_, *simulation_, accuracy_guard_, work_, *commands_, record_, odometry_sensor_,
+                           paused_, step_failure_, lockstep_timeouts_, end_time_},
+                   node_, private_node_);
 
   paused_ = parameters_.start_paused;
   restart_schedule();
@@ -298,7 +298,7 @@ int CartSimNode::run_loop(std::string& outcome) {
       publish_instant();
       if (record_failed()) break;
       if (parameters_.lockstep) wait_for_commands(time);
-      if (parameters_.fast) report_progress();
+      if (parameters_.fast) reports_->report_progress();
     }
   }
   return 0;
@@ -328,7 +328,7 @@ int CartSimNode::run() {
   if (step_failure_) {
     ROS_ERROR("cart_sim: step failed at t = %.9g s: %s", simulation_->state().time, step_failure_->c_str());
     outcome = "step failure: " + *step_failure_;
-    diagnostic_updater_->force_update();
+    reports_->publish_diagnostics();
   }
   if (internal_error) {
     ROS_FATAL("cart_sim: stopped at t = %.9g s by an unexpected error: %s", simulation_->state().time,
@@ -344,7 +344,7 @@ int CartSimNode::run() {
     ROS_FATAL("cart_sim: the record failed: %s", record_->failure()->c_str());
     outcome = "record failure: " + *record_->failure();
   }
-  write_summary(outcome);
+  reports_->write_summary(outcome);
   if (internal_error) return kExitInternalError;
   if (step_failure_) return kExitStepFailure;
   if (record_failed()) return kExitRecordFailure;

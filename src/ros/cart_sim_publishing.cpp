@@ -16,7 +16,7 @@ void CartSimNode::publish_instant() {
                       record_ ? &*record_ : nullptr);
   if (pass_due_instants(simulation_->scene().initial_state.time, parameters_.diagnostic_period, simulation_->state().time,
                         0.5 * simulation_->step_size(), next_diagnostic_index_)) {
-    diagnostic_updater_->force_update();
+    reports_->publish_diagnostics();
   }
 }
 

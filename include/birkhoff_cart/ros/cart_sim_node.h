@@ -18,12 +18,12 @@
 // Parts with a job of their own are classes: CommandInputs (the command topics, their watchdogs and
 // the lockstep answers), StepRequests (~step on its own thread), RunRecord (the bag of each run and
 // its failure), RunWorkMeter (what the run costs in wall time), InstantPublisher (the topics of a
-// publish instant, /clock and tf, and what of them goes into the bag).
+// publish instant, /clock and tf, and what of them goes into the bag), CartSimReports (/diagnostics,
+// the progress lines, the summary).
 // The member functions are defined by job: cart_sim_node.cpp (construction and the time loop),
 // cart_sim_pacing.cpp (callbacks, real-time deadlines, the lockstep barrier, following /clock),
 // cart_sim_publishing.cpp, cart_sim_services.cpp (~reset, ~pause, the bag), cart_sim_teleport.cpp
-// (~set_state, /initialpose), cart_sim_progress.cpp (the fast mode's progress line) and
-// cart_sim_summary.cpp (diagnostics, summary).
+// (~set_state, /initialpose).
 #pragma once
 
 #include <atomic>
@@ -52,6 +52,7 @@
 #include "birkhoff_cart/ros/run_record.h"
 #include "birkhoff_cart/ros/run_work_meter.h"
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
+#include "birkhoff_cart/ros/cart_sim_reports.h"
 #include "birkhoff_cart/ros/command_inputs.h"
 #include "birkhoff_cart/ros/conversions.h"
 #include "birkhoff_cart/ros/instant_publisher.h"
@@ -142,15 +143,6 @@ class CartSimNode {
   /// end of the next batch of steps), so this cart's stamps are instants of that clock, never ahead.
   void wait_for_clock(double time);
 
-  // cart_sim_progress.cpp
-  /// Fast mode: at most once per second of wall time, one log line with the scene time, the percent
-  /// of the run done and the real-time factor since the last line.
-  void report_progress();
-
-  // cart_sim_summary.cpp
-  void produce_diagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
-  void write_summary(const std::string& outcome);
-
   ros::NodeHandle node_;
   ros::NodeHandle private_node_;
   SignalingCallbackQueue callback_queue_;  ///< every subscription and service of the node
@@ -169,7 +161,6 @@ class CartSimNode {
   ros::ServiceServer set_state_service_;
   ros::Subscriber initial_pose_subscriber_;
   std::unique_ptr<StepRequests> step_requests_;  ///< ~step, on a thread of its own
-  std::unique_ptr<diagnostic_updater::Updater> diagnostic_updater_;
 
   double run_duration_ = 0.0;             ///< T: the run's length from its start [s]; +inf = without end
   double end_time_ = 0.0;                 ///< t0 + T, where the run stops exactly [s]; +inf = never
@@ -187,7 +178,8 @@ class CartSimNode {
   std::uint64_t lockstep_timeouts_ = 0;  ///< lockstep instants that went on without every answer
 
   RunWorkMeter work_;  ///< wall time of the run: integration_error, diagnostics, progress, summary
-  std::uint64_t diagnostics_rejections_seen_ = 0;
+  /// /diagnostics, progress lines, the summary; last, since it reads the members above.
+  std::optional<CartSimReports> reports_;
 };
 
 }  // namespace birkhoff_cart

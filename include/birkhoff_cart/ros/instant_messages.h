@@ -2,7 +2,7 @@
 // in place from the simulation: once they have held their strings (frame and joint names, the
 // integrator's name, the accuracy status) a publish instant allocates nothing here
 // (instant_messages_test counts the allocations of steps, fills and bag writes). ROS-free of any
-// master: publishing is the node's (cart_sim_publishing.cpp).
+// master: publishing is InstantPublisher's (instant_publisher.h).
 #pragma once
 
 #include <cstddef>
