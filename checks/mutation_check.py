@@ -155,7 +155,7 @@ MUTATIONS = [
     Mutation(
         "cmd_vel_timeout_ignored",
         "cmd_vel_controller never notices that cmd_vel fell silent (the cart keeps driving)",
-        "src/ros/cmd_vel_controller.cpp",
+        "src/core/node_logic/cmd_vel_controller.cpp",
         "const bool silent = has_command_ && s.cmd_vel_timeout > 0.0 && feedback.time - command_time_ > s.cmd_vel_timeout;",
         "const bool silent = has_command_ && s.cmd_vel_timeout < 0.0 && feedback.time - command_time_ > s.cmd_vel_timeout;",
         [("cmd_vel_controller_test", "*")],

@@ -11,7 +11,7 @@
 
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/ros/accuracy_reporting.h"
-#include "birkhoff_cart/ros/instant_schedule.h"
+#include "birkhoff_cart/core/node_logic/instant_schedule.h"
 #include "birkhoff_cart/ros/parameter_reading.h"
 
 namespace birkhoff_cart {

@@ -2,7 +2,7 @@
 // published and recorded (InstantPublisher), and /diagnostics when it is due.
 #include "birkhoff_cart/ros/cart_sim_node.h"
 
-#include "birkhoff_cart/ros/instant_schedule.h"
+#include "birkhoff_cart/core/node_logic/instant_schedule.h"
 
 namespace birkhoff_cart {
 

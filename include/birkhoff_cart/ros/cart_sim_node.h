@@ -50,7 +50,7 @@
 #include "birkhoff_cart/core/sensors/odometry_sensor.h"
 #include "birkhoff_cart/core/simulation.h"
 #include "birkhoff_cart/ros/run_record.h"
-#include "birkhoff_cart/ros/run_work_meter.h"
+#include "birkhoff_cart/core/node_logic/run_work_meter.h"
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
 #include "birkhoff_cart/ros/cart_sim_reports.h"
 #include "birkhoff_cart/ros/command_inputs.h"
@@ -59,7 +59,7 @@
 #include "birkhoff_cart/ros/shutdown_signals.h"
 #include "birkhoff_cart/ros/signaling_callback_queue.h"
 #include "birkhoff_cart/ros/step_requests.h"
-#include "birkhoff_cart/ros/wall_clock_pacing.h"
+#include "birkhoff_cart/core/node_logic/wall_clock_pacing.h"
 
 namespace birkhoff_cart {
 

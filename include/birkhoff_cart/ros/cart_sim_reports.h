@@ -18,7 +18,7 @@
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
 #include "birkhoff_cart/ros/command_inputs.h"
 #include "birkhoff_cart/ros/run_record.h"
-#include "birkhoff_cart/ros/run_work_meter.h"
+#include "birkhoff_cart/core/node_logic/run_work_meter.h"
 
 namespace birkhoff_cart {
 

@@ -27,7 +27,7 @@
 
 #include "birkhoff_cart/CmdVelControllerConfig.h"
 
-#include "birkhoff_cart/ros/cmd_vel_controller.h"
+#include "birkhoff_cart/core/node_logic/cmd_vel_controller.h"
 
 namespace birkhoff_cart {
 

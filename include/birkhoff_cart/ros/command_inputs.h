@@ -18,7 +18,7 @@
 
 #include "birkhoff_cart/core/simulation.h"
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
-#include "birkhoff_cart/ros/command_channel.h"
+#include "birkhoff_cart/core/node_logic/command_channel.h"
 
 namespace birkhoff_cart {
 

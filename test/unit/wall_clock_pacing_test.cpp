@@ -1,10 +1,9 @@
-// WallClockPacing (real-time deadlines) and run_bag_path (one bag per run), without a master.
+// WallClockPacing (real-time deadlines), ROS-free.
 #include <gtest/gtest.h>
 
 #include <chrono>
 
-#include "birkhoff_cart/ros/bag_recorder.h"
-#include "birkhoff_cart/ros/wall_clock_pacing.h"
+#include "birkhoff_cart/core/node_logic/wall_clock_pacing.h"
 
 namespace birkhoff_cart {
 namespace {
@@ -46,14 +45,6 @@ TEST(WallClockPacing, PauseDoesNotAccumulateADebt) {
   // Paused at scene time 2 s from wall 2 s to wall 12 s: restarted at the end of the pause.
   pacing.restart(at(12.0), 2.0);
   EXPECT_NEAR(pacing.scene_time_at(at(12.5)), 2.5, kTimeTolerance);  // not 12.5: no burst after a pause
-}
-
-TEST(RunBagPath, FirstRunKeepsThePathLaterRunsAreNumbered) {
-  EXPECT_EQ(run_bag_path("/data/drive.bag", 1), "/data/drive.bag");
-  EXPECT_EQ(run_bag_path("/data/drive.bag", 2), "/data/drive_run2.bag");
-  EXPECT_EQ(run_bag_path("/data/drive.bag", 12), "/data/drive_run12.bag");
-  EXPECT_EQ(run_bag_path("record", 3), "record_run3");
-  EXPECT_EQ(run_bag_path(".bag", 2), ".bag_run2");
 }
 
 }  // namespace

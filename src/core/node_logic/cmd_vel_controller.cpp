@@ -1,5 +1,5 @@
 // The cmd_vel → (τ, T) law of cmd_vel_controller (see cmd_vel_controller.h for the equations).
-#include "birkhoff_cart/ros/cmd_vel_controller.h"
+#include "birkhoff_cart/core/node_logic/cmd_vel_controller.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 // RunWorkMeter (run_work_meter.h).
-#include "birkhoff_cart/ros/run_work_meter.h"
+#include "birkhoff_cart/core/node_logic/run_work_meter.h"
 
 namespace birkhoff_cart {
 

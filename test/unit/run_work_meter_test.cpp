@@ -3,7 +3,7 @@
 
 #include <chrono>
 
-#include "birkhoff_cart/ros/run_work_meter.h"
+#include "birkhoff_cart/core/node_logic/run_work_meter.h"
 
 namespace birkhoff_cart {
 namespace {

@@ -1,5 +1,5 @@
 // Zero-order hold, rejection, clamping and watchdog of one commanded torque (see command_channel.h).
-#include "birkhoff_cart/ros/command_channel.h"
+#include "birkhoff_cart/core/node_logic/command_channel.h"
 
 #include <cmath>
 #include <stdexcept>

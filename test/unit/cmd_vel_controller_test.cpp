@@ -12,7 +12,7 @@
 
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
-#include "birkhoff_cart/ros/cmd_vel_controller.h"
+#include "birkhoff_cart/core/node_logic/cmd_vel_controller.h"
 
 namespace birkhoff_cart {
 namespace {

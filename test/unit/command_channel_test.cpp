@@ -5,7 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "birkhoff_cart/ros/command_channel.h"
+#include "birkhoff_cart/core/node_logic/command_channel.h"
 
 namespace birkhoff_cart {
 namespace {
