@@ -95,6 +95,11 @@ AccuracyGuard::AccuracyGuard(const AccuracyRequirements& requirements) : require
   validate(requirements_);
 }
 
+void AccuracyGuard::set_requirements(const AccuracyRequirements& requirements) {
+  validate(requirements);
+  requirements_ = requirements;
+}
+
 void AccuracyGuard::reset() {
   *this = AccuracyGuard(requirements_);
 }

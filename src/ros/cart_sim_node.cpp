@@ -152,6 +152,13 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
       },
       [this] { callback_queue_.wake(); });
 
+  // What may change while running (cfg/CartSim.cfg): the settings in force first, then the callback.
+  reconfigure_server_ =
+      std::make_unique<dynamic_reconfigure::Server<CartSimConfig>>(reconfigure_mutex_, private_node_);
+  reconfigure_server_->updateConfig(reconfigure_config());
+  reconfigure_server_->setCallback(
+      [this](CartSimConfig& config, std::uint32_t level) { on_reconfigure(config, level); });
+
   reports_.emplace(RunView{parameters_, *simulation_, accuracy_guard_, work_, *commands_, record_, odometry_sensor_,
                            paused_, step_failure_, lockstep_timeouts_, end_time_},
                    node_, private_node_);

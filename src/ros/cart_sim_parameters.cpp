@@ -65,7 +65,11 @@ const std::vector<std::string>& cart_sim_parameter_names() {
       "base_frame", "world_frame", "publish_world_tf", "pose_covariance_diagonal", "twist_covariance_diagonal", "publish_tf", "publish_clock",
       "follow_clock", "start_paused", "diagnostic_period", "energy_residual_warn", "energy_residual_error",
       "p2_residual_warn", "p2_residual_error", "constraint_residual_warn", "constraint_residual_error", "end_launch",
-      "accuracy/"};
+      "accuracy/",
+      // dynamic_reconfigure's own copies (cfg/CartSim.cfg), left on the master by an earlier run
+      "energy_balance_relative_warn", "energy_balance_relative_error", "p2_balance_warn", "p2_balance_error",
+      "constraint_warn", "constraint_error", "estimated_error_warn", "estimated_error_error", "energy_balance_warn",
+      "energy_balance_error"};
   return names;
 }
 

@@ -2,7 +2,9 @@
 #include "birkhoff_cart/ros/command_inputs.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
+#include <string>
 
 namespace birkhoff_cart {
 
@@ -102,6 +104,20 @@ void CommandInputs::apply_watchdogs() {
     ROS_WARN("cart_sim: no drive_torque command for %g s at t = %.6g s: drive torque set to 0",
              drive_channel_->timeout(), time);
   }
+}
+
+void CommandInputs::set_limits(double max_steering_torque, double max_drive_torque, double timeout) {
+  const auto require = [](bool ok, const std::string& what) {
+    if (!ok) throw std::invalid_argument(what);
+  };
+  require(std::isfinite(max_steering_torque) && max_steering_torque > 0.0,
+          "max_steering_torque must be finite and > 0 N m, got " + std::to_string(max_steering_torque));
+  require(std::isfinite(max_drive_torque) && max_drive_torque > 0.0,
+          "max_drive_torque must be finite and > 0 N m, got " + std::to_string(max_drive_torque));
+  require(std::isfinite(timeout) && timeout >= 0.0,
+          "command_timeout must be finite and >= 0 s, got " + std::to_string(timeout));
+  if (steering_channel_) steering_channel_->set_limits(max_steering_torque, timeout);
+  if (drive_channel_) drive_channel_->set_limits(max_drive_torque, timeout);
 }
 
 bool CommandInputs::controllers_connected() const {

@@ -98,6 +98,21 @@ TEST(AccuracyGuard, AbsoluteEnergyBalanceIsJudgedInJoulesAndOffByDefault) {
   EXPECT_THROW(AccuracyGuard{requirements}, std::invalid_argument);
 }
 
+TEST(AccuracyGuard, NewRequirementsJudgeLaterChecksAndKeepWhatWasReached) {
+  const StepStatistics statistics;
+  AccuracyGuard guard;
+  EXPECT_EQ(guard.check(0.0, made_up(100.0, 0.05), statistics), AccuracyLevel::kWarn);  // 5e-4 > 1e-4
+  AccuracyRequirements looser;
+  looser.energy_balance_relative = {true, 1e-3, 1e-1};
+  guard.set_requirements(looser);
+  EXPECT_EQ(guard.check(1.0, made_up(100.0, 0.05), statistics), AccuracyLevel::kOk);  // now fine
+  EXPECT_EQ(guard.level(), AccuracyLevel::kWarn);                                     // the WARN reached stays
+  AccuracyRequirements bad = looser;
+  bad.constraint = {true, 1.0, 1e-3};
+  EXPECT_THROW(guard.set_requirements(bad), std::invalid_argument);
+  EXPECT_EQ(guard.requirements().constraint.warn, looser.constraint.warn);  // unchanged
+}
+
 TEST(AccuracyGuard, EveryQuantityTripsOnItsOwnLimitAndNonFiniteIsAlwaysError) {
   AccuracyRequirements requirements;
   requirements.p2_balance = {true, 1e-8, 1e-6};

@@ -79,6 +79,22 @@ TEST(CommandChannel, RestartReturnsToTheInitialTorque) {
   EXPECT_TRUE(channel.check_watchdog(kTimeout + 1e-3));
 }
 
+TEST(CommandChannel, NewLimitsApplyToLaterCommandsAndBadOnesChangeNothing) {
+  CommandChannel channel(0.0, kMaxTorque, kTimeout, 0.0);
+  channel.receive(kMaxTorque, 0.0);
+  channel.set_limits(kMaxTorque / 2.0, 2.0 * kTimeout);
+  EXPECT_EQ(channel.torque(), kMaxTorque) << "the held torque stays";
+  EXPECT_EQ(channel.receive(kMaxTorque, 0.1), CommandChannel::Outcome::kClamped);
+  EXPECT_EQ(channel.torque(), kMaxTorque / 2.0);
+  EXPECT_FALSE(channel.check_watchdog(0.1 + 1.5 * kTimeout));  // the new, longer timeout
+  EXPECT_TRUE(channel.check_watchdog(0.1 + 2.0 * kTimeout + 1e-9));
+  EXPECT_THROW(channel.set_limits(0.0, kTimeout), std::invalid_argument);
+  EXPECT_THROW(channel.set_limits(kMaxTorque, -1.0), std::invalid_argument);
+  EXPECT_THROW(channel.set_limits(std::numeric_limits<double>::infinity(), kTimeout), std::invalid_argument);
+  EXPECT_EQ(channel.max_torque(), kMaxTorque / 2.0);
+  EXPECT_EQ(channel.timeout(), 2.0 * kTimeout);
+}
+
 TEST(CommandChannel, BadSettingsAreNamed) {
   EXPECT_THROW(CommandChannel(0.0, 0.0, kTimeout, 0.0), std::invalid_argument);
   EXPECT_THROW(CommandChannel(0.0, -1.0, kTimeout, 0.0), std::invalid_argument);

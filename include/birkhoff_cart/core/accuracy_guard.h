@@ -98,6 +98,10 @@ class AccuracyGuard {
   std::string current_summary() const;
 
   const AccuracyRequirements& requirements() const { return requirements_; }
+  /// New limits while running (cart_sim's dynamic_reconfigure): they judge the checks from now on;
+  /// the levels and events reached so far stay. Throws std::invalid_argument (validate()) with
+  /// nothing changed.
+  void set_requirements(const AccuracyRequirements& requirements);
   void reset();
 
  private:

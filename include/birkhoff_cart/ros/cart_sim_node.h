@@ -22,8 +22,8 @@
 // the progress lines, the summary).
 // The member functions are defined by job: cart_sim_node.cpp (construction and the time loop),
 // cart_sim_pacing.cpp (callbacks, real-time deadlines, the lockstep barrier, following /clock),
-// cart_sim_publishing.cpp, cart_sim_services.cpp (~reset, ~pause, the bag), cart_sim_teleport.cpp
-// (~set_state, /initialpose).
+// cart_sim_publishing.cpp, cart_sim_services.cpp (~reset, ~pause), cart_sim_teleport.cpp
+// (~set_state, /initialpose) and cart_sim_reconfigure.cpp (dynamic_reconfigure).
 #pragma once
 
 #include <atomic>
@@ -35,7 +35,9 @@
 #include <utility>
 #include <vector>
 
+#include <boost/thread/recursive_mutex.hpp>
 #include <diagnostic_updater/diagnostic_updater.h>
+#include <dynamic_reconfigure/server.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <ros/ros.h>
 #include <ros/spinner.h>
@@ -46,6 +48,7 @@
 #include <tf2_msgs/TFMessage.h>
 
 #include "birkhoff_cart/core/accuracy_guard.h"
+#include "birkhoff_cart/CartSimConfig.h"
 #include "birkhoff_cart/SetCartState.h"
 #include "birkhoff_cart/core/sensors/odometry_sensor.h"
 #include "birkhoff_cart/core/simulation.h"
@@ -121,6 +124,12 @@ class CartSimNode {
   /// The next step of the run's schedule (watchdogs first); false when it failed (step_failure_ set).
   bool take_step();
 
+  // cart_sim_reconfigure.cpp
+  /// The settings dynamic_reconfigure may change (cfg/CartSim.cfg), as they are in force.
+  CartSimConfig reconfigure_config() const;
+  /// A dynamic_reconfigure request: new command limits and guard limits, or a refusal by name.
+  void on_reconfigure(CartSimConfig& config, std::uint32_t level);
+
   // cart_sim_publishing.cpp
   /// One publish instant: the guard checked, the state published and recorded, /diagnostics when due.
   void publish_instant();
@@ -161,6 +170,8 @@ class CartSimNode {
   ros::ServiceServer set_state_service_;
   ros::Subscriber initial_pose_subscriber_;
   std::unique_ptr<StepRequests> step_requests_;  ///< ~step, on a thread of its own
+  boost::recursive_mutex reconfigure_mutex_;
+  std::unique_ptr<dynamic_reconfigure::Server<CartSimConfig>> reconfigure_server_;
 
   double run_duration_ = 0.0;             ///< T: the run's length from its start [s]; +inf = without end
   double end_time_ = 0.0;                 ///< t0 + T, where the run stops exactly [s]; +inf = never

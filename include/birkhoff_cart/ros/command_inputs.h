@@ -42,6 +42,9 @@ class CommandInputs {
   void restart(double time);
   /// Before each step: a channel silent for its timeout falls to 0 N·m (warned once per silence).
   void apply_watchdogs();
+  /// New limits while running (dynamic_reconfigure): the clamps [N·m] of later commands and the
+  /// watchdog's timeout [s]. Throws std::invalid_argument naming a bad value; nothing changes then.
+  void set_limits(double max_steering_torque, double max_drive_torque, double timeout);
 
   /// Lockstep: every expected topic has a publisher.
   bool controllers_connected() const;

@@ -27,6 +27,11 @@ class CommandChannel {
   /// Back to the initial torque and counters kept (a reset of the scene, not of the statistics).
   void restart(double start_time);
 
+  /// New limits while running (dynamic_reconfigure): the clamp `max_torque` [N·m] > 0 applies to
+  /// the commands received from now on (the held torque stays), the watchdog's `timeout` [s] ≥ 0
+  /// counts from the last command. Throws std::invalid_argument naming a bad value; nothing changes then.
+  void set_limits(double max_torque, double timeout);
+
   double torque() const { return torque_; }            ///< the held torque [N·m]
   double max_torque() const { return max_torque_; }    ///< [N·m]
   double timeout() const { return timeout_; }          ///< [s]
