@@ -140,8 +140,10 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   });
   reset_service_ = private_node_.advertiseService("reset", &CartSimNode::on_reset, this);
   pause_service_ = private_node_.advertiseService("pause", &CartSimNode::on_pause, this);
-  set_state_service_ = private_node_.advertiseService("set_state", &CartSimNode::on_set_state, this);
-  initial_pose_subscriber_ = node_.subscribe("initialpose", 5, &CartSimNode::on_initial_pose, this);
+  pose_requests_.emplace(node_, private_node_, parameters_, *simulation_,
+                         [this](const CartState& target, const std::string& source, std::string& message) {
+                           return teleport(target, source, message);
+                         });
   step_requests_ = std::make_unique<StepRequests>(
       private_node_,
       [this]() -> std::string {
@@ -152,12 +154,7 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
       },
       [this] { callback_queue_.wake(); });
 
-  // What may change while running (cfg/CartSim.cfg): the settings in force first, then the callback.
-  reconfigure_server_ =
-      std::make_unique<dynamic_reconfigure::Server<CartSimConfig>>(reconfigure_mutex_, private_node_);
-  reconfigure_server_->updateConfig(reconfigure_config());
-  reconfigure_server_->setCallback(
-      [this](CartSimConfig& config, std::uint32_t level) { on_reconfigure(config, level); });
+  settings_.emplace(private_node_, parameters_, accuracy_guard_, *commands_, *simulation_);
 
   reports_.emplace(RunView{parameters_, *simulation_, accuracy_guard_, work_, *commands_, record_, odometry_sensor_,
                            paused_, step_failure_, lockstep_timeouts_, end_time_},

@@ -19,11 +19,12 @@
 // the lockstep answers), StepRequests (~step on its own thread), RunRecord (the bag of each run and
 // its failure), RunWorkMeter (what the run costs in wall time), InstantPublisher (the topics of a
 // publish instant, /clock and tf, and what of them goes into the bag), CartSimReports (/diagnostics,
-// the progress lines, the summary).
+// the progress lines, the summary), PoseRequests (~set_state and initialpose), RunSettings (what
+// dynamic_reconfigure may change while running).
 // The member functions are defined by job: cart_sim_node.cpp (construction and the time loop),
 // cart_sim_pacing.cpp (callbacks, real-time deadlines, the lockstep barrier, following /clock),
 // cart_sim_publishing.cpp, cart_sim_services.cpp (~reset, ~pause), cart_sim_teleport.cpp
-// (~set_state, /initialpose) and cart_sim_reconfigure.cpp (dynamic_reconfigure).
+// (a restart of the run from a new state).
 #pragma once
 
 #include <atomic>
@@ -35,9 +36,7 @@
 #include <utility>
 #include <vector>
 
-#include <boost/thread/recursive_mutex.hpp>
 #include <diagnostic_updater/diagnostic_updater.h>
-#include <dynamic_reconfigure/server.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <ros/ros.h>
 #include <ros/spinner.h>
@@ -48,7 +47,6 @@
 #include <tf2_msgs/TFMessage.h>
 
 #include "birkhoff_cart/core/accuracy_guard.h"
-#include "birkhoff_cart/CartSimConfig.h"
 #include "birkhoff_cart/SetCartState.h"
 #include "birkhoff_cart/core/sensors/odometry_sensor.h"
 #include "birkhoff_cart/core/simulation.h"
@@ -59,6 +57,8 @@
 #include "birkhoff_cart/ros/command_inputs.h"
 #include "birkhoff_cart/ros/conversions.h"
 #include "birkhoff_cart/ros/instant_publisher.h"
+#include "birkhoff_cart/ros/pose_requests.h"
+#include "birkhoff_cart/ros/run_settings.h"
 #include "birkhoff_cart/ros/shutdown_signals.h"
 #include "birkhoff_cart/ros/signaling_callback_queue.h"
 #include "birkhoff_cart/ros/step_requests.h"
@@ -105,8 +105,6 @@ class CartSimNode {
   bool on_pause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
 
   // cart_sim_teleport.cpp
-  bool on_set_state(SetCartState::Request& request, SetCartState::Response& response);
-  void on_initial_pose(const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& message);
   /// Restarts the run from `target` at the current time (Simulation::restart_from) and restarts the
   /// commands' hold, the accuracy guard, the schedule and the publish instants there; the bag goes
   /// on. False, with `message` naming the problem and nothing changed, when it is refused.
@@ -123,12 +121,6 @@ class CartSimNode {
   void record_command(const std::string& topic, double time, const std_msgs::Float64& message);
   /// The next step of the run's schedule (watchdogs first); false when it failed (step_failure_ set).
   bool take_step();
-
-  // cart_sim_reconfigure.cpp
-  /// The settings dynamic_reconfigure may change (cfg/CartSim.cfg), as they are in force.
-  CartSimConfig reconfigure_config() const;
-  /// A dynamic_reconfigure request: new command limits and guard limits, or a refusal by name.
-  void on_reconfigure(CartSimConfig& config, std::uint32_t level);
 
   // cart_sim_publishing.cpp
   /// One publish instant: the guard checked, the state published and recorded, /diagnostics when due.
@@ -167,11 +159,9 @@ class CartSimNode {
   ros::Subscriber clock_subscriber_;  ///< /clock from elsewhere when ~publish_clock is false
   ros::ServiceServer reset_service_;
   ros::ServiceServer pause_service_;
-  ros::ServiceServer set_state_service_;
-  ros::Subscriber initial_pose_subscriber_;
+  std::optional<PoseRequests> pose_requests_;  ///< ~set_state and initialpose, teleporting through teleport()
   std::unique_ptr<StepRequests> step_requests_;  ///< ~step, on a thread of its own
-  boost::recursive_mutex reconfigure_mutex_;
-  std::unique_ptr<dynamic_reconfigure::Server<CartSimConfig>> reconfigure_server_;
+  std::optional<RunSettings> settings_;  ///< what dynamic_reconfigure may change while running
 
   double run_duration_ = 0.0;             ///< T: the run's length from its start [s]; +inf = without end
   double end_time_ = 0.0;                 ///< t0 + T, where the run stops exactly [s]; +inf = never
