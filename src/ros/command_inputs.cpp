@@ -107,15 +107,14 @@ void CommandInputs::apply_watchdogs() {
 }
 
 void CommandInputs::set_limits(double max_steering_torque, double max_drive_torque, double timeout) {
-  const auto require = [](bool ok, const std::string& what) {
-    if (!ok) throw std::invalid_argument(what);
+  const auto require = [](bool ok, const std::string& what, double value) {
+    if (!ok) throw std::invalid_argument(what + ", got " + format_seconds(value));
   };
   require(std::isfinite(max_steering_torque) && max_steering_torque > 0.0,
-          "max_steering_torque must be finite and > 0 N m, got " + std::to_string(max_steering_torque));
-  require(std::isfinite(max_drive_torque) && max_drive_torque > 0.0,
-          "max_drive_torque must be finite and > 0 N m, got " + std::to_string(max_drive_torque));
-  require(std::isfinite(timeout) && timeout >= 0.0,
-          "command_timeout must be finite and >= 0 s, got " + std::to_string(timeout));
+          "max_steering_torque must be finite and > 0 N m", max_steering_torque);
+  require(std::isfinite(max_drive_torque) && max_drive_torque > 0.0, "max_drive_torque must be finite and > 0 N m",
+          max_drive_torque);
+  require(std::isfinite(timeout) && timeout >= 0.0, "command_timeout must be finite and >= 0 s", timeout);
   if (steering_channel_) steering_channel_->set_limits(max_steering_torque, timeout);
   if (drive_channel_) drive_channel_->set_limits(max_drive_torque, timeout);
 }

@@ -27,6 +27,7 @@ RunSettings::RunSettings(ros::NodeHandle& private_node, CartSimParameters& param
   // The settings in force first (not the cfg's defaults), then the callback.
   server_.updateConfig(in_force());
   server_.setCallback([this](CartSimConfig& config, std::uint32_t level) { on_reconfigure(config, level); });
+  serving_ = true;
 }
 
 CartSimConfig RunSettings::in_force() const {
@@ -57,6 +58,7 @@ void RunSettings::on_reconfigure(CartSimConfig& config, std::uint32_t /*level*/)
     parameters_.max_steering_torque = config.max_steering_torque;
     parameters_.max_drive_torque = config.max_drive_torque;
     parameters_.command_timeout = config.command_timeout;
+    if (!serving_) return;  // setCallback's own call with the settings in force: nothing to report
     ROS_INFO("cart_sim: reconfigured at t = %s s: max steering torque %g N m, max drive torque %g N m, command "
              "timeout %g s; accuracy limits from the next publish instant",
              format_seconds(simulation_.state().time).c_str(), config.max_steering_torque, config.max_drive_torque,

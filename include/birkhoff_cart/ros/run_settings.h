@@ -37,6 +37,7 @@ class RunSettings {
   const Simulation& simulation_;
   boost::recursive_mutex mutex_;
   dynamic_reconfigure::Server<CartSimConfig> server_;
+  bool serving_ = false;  ///< past the server's first call, which only repeats the settings in force
 };
 
 }  // namespace birkhoff_cart
