@@ -89,9 +89,7 @@ void CartSimNode::wait_for_commands(double time) {
     process_callbacks();
   }
   // The answers are recorded at the instant they answer, in the order of their topics' names.
-  commands_->end_barrier(time, [this](const std::string& topic, double instant, const std_msgs::Float64& message) {
-    record_command(topic, instant, message);
-  });
+  commands_->end_barrier(time);
   // The wait is the controllers' time, not the simulator's: real-time pacing starts again here.
   if (pacing_.paced()) pacing_.restart(Clock::now(), simulation_->state().time);
 }

@@ -8,7 +8,6 @@
 #include <boost/make_shared.hpp>
 #include <std_msgs/Float64.h>
 
-#include "birkhoff_cart/core/closest_name.h"
 #include "birkhoff_cart/ros/parameter_reading.h"
 
 namespace birkhoff_cart {
@@ -96,7 +95,8 @@ CmdVelControllerNode::CmdVelControllerNode(ros::NodeHandle node, ros::NodeHandle
       private_node_(private_node),
       shut_down_on_refusal_(shut_down_on_refusal),
       controller_(load_cmd_vel_controller_settings(private_node)),
-      steering_joint_(private_node.param<std::string>("steering_joint", "steering_joint")) {
+      steering_joint_(private_node.param<std::string>("steering_joint", "steering_joint")),
+      joint_check_state_(steering_joint_, kJointGrace) {
   steering_publisher_ = node_.advertise<std_msgs::Float64>("steering_torque", 10);
   drive_publisher_ = node_.advertise<std_msgs::Float64>("drive_torque", 10);
   cmd_vel_subscriber_ = node_.subscribe("cmd_vel", 10, &CmdVelControllerNode::on_cmd_vel, this);
@@ -186,18 +186,14 @@ void CmdVelControllerNode::on_reconfigure(CmdVelControllerConfig& config, std::u
 }
 
 void CmdVelControllerNode::check_joint_names(const ros::WallTimerEvent&) {
-  if (steering_joint_seen_) {
+  if (joint_check_state_.seen()) {
     joint_check_.stop();
     return;
   }
-  if (!first_without_joint_ || (ros::WallTime::now() - *first_without_joint_).toSec() < kJointGrace) return;
-  std::string names;
-  for (const std::string& name : names_without_joint_) names += (names.empty() ? "" : ", ") + name;
-  const std::string guess = closest_name(steering_joint_, names_without_joint_);
-  refusal_ = "joint '" + steering_joint_ + "' (" + private_node_.resolveName("steering_joint") +
-             ") is not in " + joint_state_subscriber_.getTopic() + ", which names " + (names.empty() ? "no joint" : names) +
-             (guess.empty() ? "" : " (did you mean '" + guess + "'?)") +
-             ": without the steering angle the controller cannot steer, so it does not run";
+  const std::optional<std::string> refusal = joint_check_state_.refusal(
+      ros::WallTime::now().toSec(), private_node_.resolveName("steering_joint"), joint_state_subscriber_.getTopic());
+  if (!refusal) return;
+  refusal_ = *refusal;
   ROS_FATAL("cmd_vel_controller: %s", refusal_.c_str());
   joint_check_.stop();
   if (shut_down_on_refusal_) {
@@ -216,16 +212,13 @@ void CmdVelControllerNode::on_odometry(const nav_msgs::Odometry::ConstPtr& messa
 }
 
 void CmdVelControllerNode::on_joint_states(const sensor_msgs::JointState::ConstPtr& message) {
-  const auto joint = std::find(message->name.begin(), message->name.end(), steering_joint_);
-  if (joint == message->name.end()) {  // another publisher's joints, or a wrong ~steering_joint
-    if (!first_without_joint_) {
-      first_without_joint_ = ros::WallTime::now();
-      names_without_joint_ = message->name;
-    }
+  // Another publisher's joints, or a wrong ~steering_joint (refused after kJointGrace).
+  const std::optional<std::size_t> found = joint_check_state_.find(message->name);
+  if (!found) {
+    joint_check_state_.note_missing(message->name, ros::WallTime::now().toSec());
     return;
   }
-  steering_joint_seen_ = true;
-  const std::size_t index = static_cast<std::size_t>(joint - message->name.begin());
+  const std::size_t index = *found;
   if (index >= message->position.size() || index >= message->velocity.size()) {
     ROS_WARN_THROTTLE(5.0, "cmd_vel_controller: joint_states without position and velocity of %s",
                       steering_joint_.c_str());

@@ -142,12 +142,14 @@ std::string CommandInputs::unanswered_topics() const {
          (drive ? "drive_torque" : "");
 }
 
-void CommandInputs::end_barrier(double time, const RecordCommand& record) {
+void CommandInputs::end_barrier(double time) {
   steering_answered_ = false;
   drive_answered_ = false;
   std::stable_sort(lockstep_records_.begin(), lockstep_records_.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
-  for (const auto& [topic, message] : lockstep_records_) record(topic, time, message);
+  if (record_) {
+    for (const auto& [topic, message] : lockstep_records_) record_(topic, time, message);
+  }
   lockstep_records_.clear();
 }
 

@@ -9,7 +9,6 @@
 #include <boost/make_shared.hpp>
 #include <std_msgs/Float64.h>
 
-#include "birkhoff_cart/core/closest_name.h"
 #include "birkhoff_cart/ros/parameter_reading.h"
 
 namespace birkhoff_cart {
@@ -22,7 +21,8 @@ SteeringPdController::SteeringPdController(ros::NodeHandle node, ros::NodeHandle
       frequency_(read_double_parameter(private_node, "frequency", 0.25)),
       drive_torque_(read_double_parameter(private_node, "drive_torque", 5.0)),
       steering_joint_(private_node.param<std::string>("steering_joint", "steering_joint")),
-      shut_down_on_refusal_(shut_down_on_refusal) {
+      shut_down_on_refusal_(shut_down_on_refusal),
+      joint_check_state_(steering_joint_, kJointGrace) {
   if (!std::isfinite(kp_) || !std::isfinite(kd_) || !std::isfinite(amplitude_) || !std::isfinite(frequency_) ||
       !std::isfinite(drive_torque_)) {
     throw std::invalid_argument("~kp, ~kd, ~amplitude, ~frequency and ~drive_torque must be finite");
@@ -46,21 +46,14 @@ SteeringPdController::SteeringPdController(ros::NodeHandle node, ros::NodeHandle
 
 void SteeringPdController::on_joint_states(const sensor_msgs::JointState::ConstPtr& joints) {
   if (refused_) return;
-  const auto found = std::find(joints->name.begin(), joints->name.end(), steering_joint_);
-  const std::size_t index = static_cast<std::size_t>(std::distance(joints->name.begin(), found));
-  if (found == joints->name.end()) {
-    // Another publisher's partial joint_states may lack it; the name is refused only when no
-    // message has held it within kJointGrace (check_joint_name).
-    if (!steering_joint_seen_) {
-      const std::lock_guard<std::mutex> lock(missing_joint_mutex_);
-      if (!first_without_joint_) {
-        first_without_joint_ = ros::WallTime::now();
-        names_without_joint_ = joints->name;
-      }
-    }
+  // Another publisher's partial joint_states may lack it; the name is refused only when no
+  // message has held it within kJointGrace (check_joint_name).
+  const std::optional<std::size_t> found = joint_check_state_.find(joints->name);
+  if (!found) {
+    joint_check_state_.note_missing(joints->name, ros::WallTime::now().toSec());
     return;
   }
-  if (!steering_joint_seen_) steering_joint_seen_ = true;
+  const std::size_t index = *found;
   if (index >= joints->position.size() || index >= joints->velocity.size()) {
     ROS_ERROR_THROTTLE(1.0, "steering_pd_controller: joint_states names %s without its position and velocity",
                        steering_joint_.c_str());
@@ -79,22 +72,14 @@ void SteeringPdController::on_joint_states(const sensor_msgs::JointState::ConstP
 }
 
 void SteeringPdController::check_joint_name(const ros::WallTimerEvent&) {
-  if (steering_joint_seen_) {
+  if (joint_check_state_.seen()) {
     joint_check_.stop();
     return;
   }
-  std::vector<std::string> seen_names;
-  {
-    const std::lock_guard<std::mutex> lock(missing_joint_mutex_);
-    if (!first_without_joint_ || (ros::WallTime::now() - *first_without_joint_).toSec() < kJointGrace) return;
-    seen_names = names_without_joint_;
-  }
-  std::string names;
-  for (const std::string& name : seen_names) names += (names.empty() ? "" : ", ") + name;
-  const std::string guess = closest_name(steering_joint_, seen_names);
-  refusal_ = "joint '" + steering_joint_ + "' (~steering_joint) is not in " + subscriber_.getTopic() + ", which names " +
-             (names.empty() ? "no joint" : names) + (guess.empty() ? "" : " (did you mean '" + guess + "'?)") +
-             ": without the steering angle the controller cannot steer, so it does not run";
+  const std::optional<std::string> refusal =
+      joint_check_state_.refusal(ros::WallTime::now().toSec(), "~steering_joint", subscriber_.getTopic());
+  if (!refusal) return;
+  refusal_ = *refusal;
   refused_ = true;
   ROS_FATAL("steering_pd_controller: %s", refusal_.c_str());
   joint_check_.stop();

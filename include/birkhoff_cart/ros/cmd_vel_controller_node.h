@@ -28,6 +28,7 @@
 #include "birkhoff_cart/CmdVelControllerConfig.h"
 
 #include "birkhoff_cart/core/node_logic/cmd_vel_controller.h"
+#include "birkhoff_cart/core/node_logic/missing_joint_check.h"
 
 namespace birkhoff_cart {
 
@@ -79,9 +80,7 @@ class CmdVelControllerNode {
   ros::Time last_update_stamp_;   ///< the instant the law last ran on
   ros::Time latest_stamp_;        ///< the latest simulator instant seen (cmd_vel arrival time)
   bool timeout_reported_ = false;
-  bool steering_joint_seen_ = false;           ///< some joint_states held ~steering_joint
-  std::optional<ros::WallTime> first_without_joint_;  ///< the first joint_states without it
-  std::vector<std::string> names_without_joint_;      ///< the joint names that message held
+  MissingJointCheck joint_check_state_;  ///< ~steering_joint in joint_states, or its refusal after kJointGrace
   ros::WallTimer joint_check_;
   std::string refusal_;
   /// The server's mutex, ours so that updateConfig() at start-up is safe (the server warns otherwise).

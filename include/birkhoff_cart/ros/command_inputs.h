@@ -54,10 +54,10 @@ class CommandInputs {
   std::string expected_topics() const;
   /// The expected topics that have not answered, "steering_torque and drive_torque".
   std::string unanswered_topics() const;
-  /// Lockstep, after the wait at instant `time` [s]: the answers go to `record` in the order of
-  /// their topics' names (answers arrive over separate connections in any order; so two identical
-  /// runs record identical bags), and the next instant waits afresh.
-  void end_barrier(double time, const RecordCommand& record);
+  /// Lockstep, after the wait at instant `time` [s]: the answers go to subscribe()'s `record` in
+  /// the order of their topics' names (answers arrive over separate connections in any order; so
+  /// two identical runs record identical bags), and the next instant waits afresh.
+  void end_barrier(double time);
 
   const std::optional<CommandChannel>& steering() const { return steering_channel_; }
   const std::optional<CommandChannel>& drive() const { return drive_channel_; }

@@ -11,14 +11,13 @@
 #pragma once
 
 #include <atomic>
-#include <mutex>
-#include <optional>
 #include <string>
 #include <vector>
 
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 
+#include "birkhoff_cart/core/node_logic/missing_joint_check.h"
 #include "birkhoff_cart/ros/inline_callback_queue.h"
 
 namespace birkhoff_cart {
@@ -51,13 +50,8 @@ class SteeringPdController {
   double drive_torque_;  ///< [N·m]
   std::string steering_joint_;  ///< the joint whose position and velocity are χ, χ̇
   bool shut_down_on_refusal_;
-  // joint_states may be served in cart_sim's thread (inline_answers) while the check runs on the
-  // node's queue: the flags are atomic, the first message without the joint is under a mutex.
-  std::atomic<bool> steering_joint_seen_{false};
+  MissingJointCheck joint_check_state_;  ///< ~steering_joint in joint_states, or its refusal after kJointGrace
   std::atomic<bool> refused_{false};
-  std::mutex missing_joint_mutex_;
-  std::optional<ros::WallTime> first_without_joint_;  ///< the first joint_states without it (while never seen)
-  std::vector<std::string> names_without_joint_;       ///< the joints that message named
   std::string refusal_;  ///< written once, before refused_ is set
   ros::WallTimer joint_check_;
   InlineCallbackQueue inline_queue_;  ///< with inline_answers: joint_states served in the publisher's thread
