@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "birkhoff_cart/core/birkhoffian_system.h"
+#include "all_effects.h"
 #include "birkhoff_cart/core/cart_birkhoffian.h"
 #include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/effect_library.h"
@@ -21,26 +22,7 @@ namespace {
 constexpr double kEquationTolerance = 1e-12;  // relative residual of ż [-]
 constexpr double kConversionTolerance = 1e-14;  // relative round trip [-]
 
-/// All six effects on, with non-trivial time profiles.
-std::vector<EffectSpec> all_effect_specs() {
-  std::vector<EffectSpec> specs(6);
-  specs[0].name = "steering_torque";
-  specs[0].profile.kind = TorqueProfile::Kind::kCosine;
-  specs[0].profile.amplitude = 3.0;     // [N·m]
-  specs[0].profile.frequency = 0.4;     // [Hz]
-  specs[1].name = "drive_torque";
-  specs[1].profile.kind = TorqueProfile::Kind::kConstant;
-  specs[1].profile.value = 25.0;        // [N·m]
-  specs[2].name = "rolling_resistance";
-  specs[2].coefficients = {{"coefficient", 0.015}, {"speed_epsilon", 0.05}};
-  specs[3].name = "air_drag";
-  specs[3].coefficients = {{"coefficient", 0.4}};
-  specs[4].name = "steering_damping";
-  specs[4].coefficients = {{"coefficient", 2.0}};
-  specs[5].name = "steering_stiffness";
-  specs[5].coefficients = {{"coefficient", 15.0}};
-  return specs;
-}
+using birkhoff_cart_test::all_effect_specs;
 
 class CartBirkhoffianTest : public ::testing::Test {
  protected:

@@ -17,15 +17,24 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cmath>
+#include <cstddef>
 
 #include "birkhoff_cart/core/autodiff.h"
 #include "birkhoff_cart/core/birkhoffian_system.h"
 #include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/effects.h"
 #include "birkhoff_cart/core/state.h"
+#include "birkhoff_cart/core/vector_math.h"
 
 namespace birkhoff_cart {
+
+/// 0 of the scalar type of `like` (an AD jet with an empty derivative part for jets).
+template <class S>
+S cart_birkhoffian_zero(const S& like) {
+  return S(0.0) * like;
+}
 
 /// A point of the cart in Birkhoffian variables.
 struct CartBirkhoffianPoint {
@@ -74,6 +83,25 @@ class CartBirkhoffianBase {
     return model_->quasi_velocity(z(kSteeringAngleIndex),
                                   Vector2<S>(z(kForwardMomentumIndex), z(kSteeringMomentumIndex)));
   }
+  /// The same from s = sin χ.
+  template <class S>
+  Vector2<S> quasi_velocity_at(const S& s, const Vector<S>& z) const {
+    return model_->quasi_velocity_at(s, Vector2<S>(z(kForwardMomentumIndex), z(kSteeringMomentumIndex)));
+  }
+
+  /// sin χ and cos χ [-]: every rate below computes them once per evaluation (one sincos).
+  template <class S>
+  struct SteeringTrig {
+    S s;
+    S c;
+  };
+  template <class S>
+  static SteeringTrig<S> steering_trig(const S& steering_angle) {
+    using std::cos;
+    using std::sin;
+    return {sin(steering_angle), cos(steering_angle)};
+  }
+
 
   /// Q = (Q1 [N], Q2 [N·m]) of the enabled loads at χ [rad] and ω = M(χ)⁻¹ p [m/s, rad/s] (the
   /// caller's, so that one evaluation of the right-hand side solves M ω = p once); zero when the
@@ -149,12 +177,26 @@ class CartBirkhoffianBase {
     return model_->momentum_rate(chi, omega, generalized_force(chi, omega, t));
   }
 
+  /// The rates of the passive coordinates that g reads, each of which depends on z alone: θ̇ =
+  /// ω1 sin χ / l (eq. (2.3)), the other entries zero. The first of a collocation's
+  /// kPassiveCouplingDepth + 1 passive sweeps needs only these (gauss_collocation.h); they equal the
+  /// θ̇ of passive_rates bit for bit.
+  template <class S>
+  Passive<S> passive_coupling_rates(const Vector<S>& z, const S& /*t*/) const {
+    const SteeringTrig<S> trig = steering_trig(z(kSteeringAngleIndex));
+    Passive<S> rate = Passive<S>::Constant(cart_birkhoffian_zero(z(kSteeringAngleIndex)));
+    rate(kHeadingIndex) = model_->heading_rate_at(trig.s, quasi_velocity_at(trig.s, z));
+    return rate;
+  }
+
   /// ẏ = g(z, y, t) = (ẋ, ẏ, θ̇, φ̇1..φ̇4, ω·Q, Q2) (eqs. (2.3)–(2.4), (3.7)). Reads only the heading
   /// θ = y(kHeadingIndex) of y (ẋ, ẏ need it), and θ̇ depends on z alone: g is triangular in y.
   template <class S>
   Passive<S> passive_rates(const Vector<S>& z, const Passive<S>& y, const S& t) const {
-    const Vector2<S> omega = quasi_velocity(z);
-    const CoordinateRates<S> rates = model_->coordinate_rates(y(kHeadingIndex), z(kSteeringAngleIndex), omega);
+    const SteeringTrig<S> trig = steering_trig(z(kSteeringAngleIndex));
+    const Vector2<S> omega = quasi_velocity_at(trig.s, z);
+    const CoordinateRates<S> rates =
+        model_->coordinate_rates_at(y(kHeadingIndex), z(kSteeringAngleIndex), trig.s, trig.c, omega);
     const Vector2<S> force = generalized_force(z(kSteeringAngleIndex), omega, t);
     Passive<S> rate;
     rate(kXIndex) = rates.x_rate;
@@ -179,10 +221,45 @@ S zero_like(const S& s) {
 }
 }  // namespace cart_birkhoffian_detail
 
+/// ẇ of a form (CRTP: Form::darboux_rates_at(w, t, sin/cos of χ)) at one point, and at the s
+/// stages of a collocation step at once.
+template <class Form>
+class CartStageRates {
+ public:
+  template <class S>
+  using Vector = CartBirkhoffianBase::Vector<S>;
+
+  /// ẇ(w, t).
+  template <class S>
+  Vector<S> darboux_rates(const Vector<S>& w, const S& t) const {
+    return form().darboux_rates_at(w, t, CartBirkhoffianBase::steering_trig(w(kSteeringAngleIndex)));
+  }
+  /// ẇ at the stages w[j], times t[j] (gauss_collocation.h): sin χ, cos χ of all of them from one
+  /// sin_cos_lanes call (vector_math.h), the rest as darboux_rates. On the scalar path bit-identical
+  /// to darboux_rates point by point.
+  template <std::size_t Count>
+  void darboux_rates_stages(const std::array<Vector<double>, Count>& w, const std::array<double, Count>& t,
+                            std::array<Vector<double>, Count>& rates) const {
+    static_assert(Count <= kMaxVectorLanes, "one vector call takes at most kMaxVectorLanes angles");
+    double angles[Count];
+    double sines[Count];
+    double cosines[Count];
+    for (std::size_t j = 0; j < Count; ++j) angles[j] = w[j](kSteeringAngleIndex);
+    sin_cos_lanes(angles, static_cast<int>(Count), sines, cosines);
+    for (std::size_t j = 0; j < Count; ++j) {
+      rates[j] = form().darboux_rates_at(w[j], t[j], CartBirkhoffianBase::SteeringTrig<double>{sines[j], cosines[j]});
+    }
+  }
+
+ private:
+  const Form& form() const { return static_cast<const Form&>(*this); }
+};
+
 /// Representation (b): autonomous canonical form, K = K₀ (eqs. (B.6)–(B.8)).
-class CartAutonomousBirkhoffian : public CartBirkhoffianBase {
+class CartAutonomousBirkhoffian : public CartBirkhoffianBase, public CartStageRates<CartAutonomousBirkhoffian> {
  public:
   using CartBirkhoffianBase::CartBirkhoffianBase;
+  using CartBirkhoffianBase::Vector;
 
   /// No structure epoch: K = K₀ does not depend on time.
   void begin_step(double /*t*/) {}
@@ -238,29 +315,81 @@ class CartAutonomousBirkhoffian : public CartBirkhoffianBase {
   Vector<S> from_darboux(const Vector<S>& w, const S& /*t*/) const {
     return w;
   }
-  /// ẇ = ż = (ω, ṗ) with ṗ = ∂T*/∂q|_ω + Λ_nh + Q (enabled) or −∂H̃/∂q (Birkhoffian part).
+  /// ẇ = ż = (ω, ṗ) with ṗ = ∂T*/∂q|_ω + Λ_nh + Q (enabled) or −∂H̃/∂q (Birkhoffian part), with
+  /// sin χ, cos χ given (darboux_rates and darboux_rates_stages: CartStageRates).
   template <class S>
-  Vector<S> darboux_rates(const Vector<S>& w, const S& t) const {
-    const Vector2<S> omega = quasi_velocity(w);
+  Vector<S> darboux_rates_at(const Vector<S>& w, const S& t, const SteeringTrig<S>& trig) const {
+    const S& chi = w(kSteeringAngleIndex);
+    const Vector2<S> omega = quasi_velocity_at(trig.s, w);
     Vector<S> rate;
     rate(kArcLengthIndex) = omega(0);
     rate(kSteeringAngleIndex) = omega(1);
     if (non_birkhoffian_force_enabled_) {
-      const Vector2<S> p_rate = momentum_rate(w(kSteeringAngleIndex), omega, t);
+      const Vector2<S> p_rate = model_->momentum_rate_at(trig.s, trig.c, omega, generalized_force(chi, omega, t));
       rate(kForwardMomentumIndex) = p_rate(0);
       rate(kSteeringMomentumIndex) = p_rate(1);
     } else {
       rate(kForwardMomentumIndex) = cart_birkhoffian_detail::zero_like(omega(0));
-      rate(kSteeringMomentumIndex) = model_->kinetic_energy_steering_derivative(w(kSteeringAngleIndex), omega);
+      rate(kSteeringMomentumIndex) = model_->kinetic_energy_steering_derivative_at(trig.s, trig.c, omega);
     }
     return rate;
+  }
+
+  /// J = ∂ẇ/∂w [rows: rates of (π1, χ, p1, p2); columns: (π1, χ, p1, p2)] in closed form, for the
+  /// implicit members' Newton matrices (gauss_collocation.h; test/unit/cart_jacobian_test.cpp checks it
+  /// against automatic differentiation of darboux_rates). With ω = M⁻¹p (eq. (3.5)):
+  ///   ∂ω/∂p = M⁻¹,  ∂ω/∂χ = −M⁻¹ (dM/dχ) ω,  dM/dχ = [[2 μ1 s c, ν c], [ν c, 0]]   (eq. (3.3));
+  ///   ṗ = (Λ1 + Q1, Q2), Λ1 = μ1 s c ω1 ω2 + ν c ω2²                                   (eq. (3.8)),
+  ///   ∂ṗ/∂w = ∂ṗ/∂χ|_ω e_χᵀ + ∂ṗ/∂ω ∂ω/∂w, with ∂Q/∂(χ, ω) from the effects.
+  /// The π1 column is zero: no rate reads the arc length.
+  Matrix<double> darboux_jacobian(const Vector<double>& w, double t) const {
+    const double chi = w(kSteeringAngleIndex);
+    const SteeringTrig<double> trig = steering_trig(chi);
+    const double s = trig.s;
+    const double c = trig.c;
+    const ReducedInertia& inertia = model_->inertia();
+    const Matrix2<double> mass = model_->mass_matrix_at(s);
+    const double determinant = mass(0, 0) * mass(1, 1) - mass(0, 1) * mass(1, 0);
+    Matrix2<double> mass_inverse;
+    mass_inverse << mass(1, 1) / determinant, -mass(0, 1) / determinant, -mass(1, 0) / determinant,
+        mass(0, 0) / determinant;
+    const Vector2<double> omega = mass_inverse * Vector2<double>(w(kForwardMomentumIndex), w(kSteeringMomentumIndex));
+    Matrix2<double> mass_rate;  // dM/dχ
+    mass_rate << 2.0 * inertia.mu1 * s * c, inertia.nu * c, inertia.nu * c, 0.0;
+    // ∂ω/∂(χ, p1, p2): columns χ, p1, p2
+    Eigen::Matrix<double, 2, 3> omega_partials;
+    omega_partials.col(0) = -mass_inverse * (mass_rate * omega);
+    omega_partials.rightCols<2>() = mass_inverse;
+    // ṗ's partials at fixed ω (χ) and in ω
+    Eigen::Matrix<double, 2, 1> p_rate_chi;
+    Matrix2<double> p_rate_omega;
+    const double w1 = omega(0);
+    const double w2 = omega(1);
+    if (non_birkhoffian_force_enabled_) {
+      const GeneralizedForce load = effects_->force_and_jacobian(t, chi, omega);
+      p_rate_chi << inertia.mu1 * (c * c - s * s) * w1 * w2 - inertia.nu * s * w2 * w2 + load.jacobian(0, 0),
+          load.jacobian(1, 0);
+      p_rate_omega << inertia.mu1 * s * c * w2 + load.jacobian(0, 1),
+          inertia.mu1 * s * c * w1 + 2.0 * inertia.nu * c * w2 + load.jacobian(0, 2), load.jacobian(1, 1),
+          load.jacobian(1, 2);
+    } else {  // ṗ = (0, ∂T*/∂χ|_ω), ∂T*/∂χ = μ1 s c ω1² + ν c ω1 ω2
+      p_rate_chi << 0.0, inertia.mu1 * (c * c - s * s) * w1 * w1 - inertia.nu * s * w1 * w2;
+      p_rate_omega << 0.0, 0.0, 2.0 * inertia.mu1 * s * c * w1 + inertia.nu * c * w2, inertia.nu * c * w1;
+    }
+    Eigen::Matrix<double, 2, 3> p_rate_partials = p_rate_omega * omega_partials;
+    p_rate_partials.col(0) += p_rate_chi;
+    Matrix<double> jacobian = Matrix<double>::Zero();
+    jacobian.block<2, 3>(kArcLengthIndex, kSteeringAngleIndex) = omega_partials;
+    jacobian.block<2, 3>(kForwardMomentumIndex, kSteeringAngleIndex) = p_rate_partials;
+    return jacobian;
   }
 };
 
 /// Representation (a): the paper's time-dependent form, K = e^{t−tₑ} K₀ (eqs. (B.9)–(B.11)).
-class CartPaperBirkhoffian : public CartBirkhoffianBase {
+class CartPaperBirkhoffian : public CartBirkhoffianBase, public CartStageRates<CartPaperBirkhoffian> {
  public:
   using CartBirkhoffianBase::CartBirkhoffianBase;
+  using CartBirkhoffianBase::Vector;
 
   /// Sets the structure epoch tₑ = t [s]: a constant factor e^{−tₑ} on R and B leaves Birkhoff's
   /// equations unchanged and keeps e^{t−tₑ} = O(1) (no overflow at t ≈ 709 s).
@@ -338,21 +467,23 @@ class CartPaperBirkhoffian : public CartBirkhoffianBase {
   }
   /// ẇ = D_z ż + ∂_t D = (ω, e^{t−tₑ} (ṗ + p)): with Λ, ṗ + p = ∂T*/∂q|_ω + Λ_nh + Q + p; without,
   /// ṗ = −∂H̃/∂q − p, so ẇ_p = e^{t−tₑ} ∂T*/∂q|_ω (Hamiltonian in the chart with H_w = e^{t−tₑ} H̃).
+  /// With sin χ, cos χ given (χ is the same in z and w; darboux_rates: CartStageRates).
   template <class S>
-  Vector<S> darboux_rates(const Vector<S>& w, const S& t) const {
+  Vector<S> darboux_rates_at(const Vector<S>& w, const S& t, const SteeringTrig<S>& trig) const {
     const S e = conformal_factor(t);
     const Vector<S> z = from_darboux(w, t);
-    const Vector2<S> omega = quasi_velocity(z);
+    const S& chi = z(kSteeringAngleIndex);
+    const Vector2<S> omega = quasi_velocity_at(trig.s, z);
     Vector<S> rate;
     rate(kArcLengthIndex) = omega(0);
     rate(kSteeringAngleIndex) = omega(1);
     if (non_birkhoffian_force_enabled_) {
-      const Vector2<S> p_rate = momentum_rate(z(kSteeringAngleIndex), omega, t);
+      const Vector2<S> p_rate = model_->momentum_rate_at(trig.s, trig.c, omega, generalized_force(chi, omega, t));
       rate(kForwardMomentumIndex) = e * (p_rate(0) + z(kForwardMomentumIndex));
       rate(kSteeringMomentumIndex) = e * (p_rate(1) + z(kSteeringMomentumIndex));
     } else {
       rate(kForwardMomentumIndex) = cart_birkhoffian_detail::zero_like(e);
-      rate(kSteeringMomentumIndex) = e * model_->kinetic_energy_steering_derivative(z(kSteeringAngleIndex), omega);
+      rate(kSteeringMomentumIndex) = e * model_->kinetic_energy_steering_derivative_at(trig.s, trig.c, omega);
     }
     return rate;
   }

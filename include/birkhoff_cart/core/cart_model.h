@@ -47,7 +47,13 @@ class CartModel {
   template <class Scalar>
   Matrix2<Scalar> mass_matrix(const Scalar& steering_angle) const {
     using std::sin;
-    const Scalar s = sin(steering_angle);
+    return mass_matrix_at(Scalar(sin(steering_angle)));
+  }
+
+  /// M(χ) from s = sin χ [-] (the right-hand sides compute sin χ and cos χ once per evaluation and
+  /// hand them to the *_at functions: one sincos instead of three calls).
+  template <class Scalar>
+  Matrix2<Scalar> mass_matrix_at(const Scalar& s) const {
     Matrix2<Scalar> mass;
     mass(0, 0) = inertia_.mu + inertia_.mu1 * s * s;
     mass(0, 1) = inertia_.nu * s;
@@ -72,6 +78,11 @@ class CartModel {
   template <class Scalar>
   Vector2<Scalar> quasi_velocity(const Scalar& steering_angle, const Vector2<Scalar>& momentum) const {
     return solve_mass(mass_matrix(steering_angle), momentum);
+  }
+  /// ω = M(χ)⁻¹ p from s = sin χ.
+  template <class Scalar>
+  Vector2<Scalar> quasi_velocity_at(const Scalar& s, const Vector2<Scalar>& momentum) const {
+    return solve_mass(mass_matrix_at(s), momentum);
   }
 
   /// Nonholonomic (gyroscopic) force of the canonical form (eq. (3.6)):
@@ -109,8 +120,13 @@ class CartModel {
                                 const Vector2<Scalar>& generalized_force) const {
     using std::cos;
     using std::sin;
-    const Scalar s = sin(steering_angle);
-    const Scalar c = cos(steering_angle);
+    return momentum_rate_at(Scalar(sin(steering_angle)), Scalar(cos(steering_angle)), quasi_velocity,
+                            generalized_force);
+  }
+  /// ṗ of eq. (3.8) from s = sin χ, c = cos χ.
+  template <class Scalar>
+  Vector2<Scalar> momentum_rate_at(const Scalar& s, const Scalar& c, const Vector2<Scalar>& quasi_velocity,
+                                   const Vector2<Scalar>& generalized_force) const {
     Vector2<Scalar> rate;
     rate(0) = nonholonomic_force_at(s, c, quasi_velocity)(0) + generalized_force(0);  // Λ_nh,1 + Q1
     rate(1) = generalized_force(1);
@@ -140,8 +156,12 @@ class CartModel {
                               std::array<double, 4>& d2) const {
     using std::cos;
     using std::sin;
-    const Scalar s = sin(steering_angle);
-    const Scalar c = cos(steering_angle);
+    rim_speed_coefficients_at(Scalar(sin(steering_angle)), Scalar(cos(steering_angle)), d1, d2);
+  }
+  /// The same from s = sin χ, c = cos χ.
+  template <class Scalar>
+  void rim_speed_coefficients_at(const Scalar& s, const Scalar& c, std::array<Scalar, 4>& d1,
+                                 std::array<double, 4>& d2) const {
     const double l = parameters_.wheelbase;
     const double a = parameters_.rear_half_track;
     const double cf = parameters_.front_half_track;
@@ -161,19 +181,41 @@ class CartModel {
                                            const Vector2<Scalar>& quasi_velocity) const {
     using std::cos;
     using std::sin;
+    return coordinate_rates_at(heading, steering_angle, Scalar(sin(steering_angle)), Scalar(cos(steering_angle)),
+                               quasi_velocity);
+  }
+  /// The same from s = sin χ, c = cos χ.
+  template <class Scalar>
+  CoordinateRates<Scalar> coordinate_rates_at(const Scalar& heading, const Scalar& steering_angle, const Scalar& s,
+                                              const Scalar& c, const Vector2<Scalar>& quasi_velocity) const {
+    using std::cos;
+    using std::sin;
     CoordinateRates<Scalar> rates;
     const Scalar front_heading = heading + steering_angle;
     rates.x_rate = quasi_velocity(0) * cos(front_heading);
     rates.y_rate = quasi_velocity(0) * sin(front_heading);
-    rates.heading_rate = quasi_velocity(0) * sin(steering_angle) / parameters_.wheelbase;
+    rates.heading_rate = heading_rate_at(s, quasi_velocity);
     std::array<Scalar, 4> d1;
     std::array<double, 4> d2;
-    rim_speed_coefficients(steering_angle, d1, d2);
+    rim_speed_coefficients_at(s, c, d1, d2);
     for (int wheel = 0; wheel < 4; ++wheel) {
       rates.wheel_spin_rate[wheel] =
           (d1[wheel] * quasi_velocity(0) + d2[wheel] * quasi_velocity(1)) / wheel_radius(wheel);
     }
     return rates;
+  }
+
+  /// θ̇ = ω1 sin χ / l [rad/s] (eq. (2.3)) from s = sin χ.
+  template <class Scalar>
+  Scalar heading_rate_at(const Scalar& s, const Vector2<Scalar>& quasi_velocity) const {
+    return quasi_velocity(0) * s / parameters_.wheelbase;
+  }
+
+  /// ∂T*/∂χ at constant ω from s = sin χ, c = cos χ.
+  template <class Scalar>
+  Scalar kinetic_energy_steering_derivative_at(const Scalar& s, const Scalar& c,
+                                               const Vector2<Scalar>& quasi_velocity) const {
+    return -nonholonomic_force_at(s, c, quasi_velocity)(1);
   }
 
   /// T* of a state [J].

@@ -90,6 +90,18 @@ class EffectSet {
   /// Sum of the effects alone, without the end stops' reaction.
   GeneralizedForce evaluate_loads(const EffectInput& input) const;
 
+  /// Q with its Jacobian ∂Q/∂(χ, ω1, ω2) at a point (zero when no effect and no end stop acts): for
+  /// analytic Jacobians of the rates (cart_birkhoffian.h darboux_jacobian).
+  GeneralizedForce force_and_jacobian(double time, double steering_angle, const Vector2<double>& quasi_velocity) const {
+    if (effects_.empty() && !end_stops_) return GeneralizedForce{};
+    EffectInput input;
+    input.time = time;
+    input.steering_angle = steering_angle;
+    input.forward_speed = quasi_velocity(0);
+    input.steering_rate = quasi_velocity(1);
+    return evaluate(input);
+  }
+
   /// Q as scalars of type S: plain values for double, values with derivatives propagated through
   /// the analytic Jacobian for AD scalars (t is never differentiated).
   template <class S>

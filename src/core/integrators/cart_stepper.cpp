@@ -55,7 +55,7 @@ class CartStepperAdapter final : public CartStepper {
     }
     require_finite_result(name_, time, step_size, point.z, point.y);
     const CartState next = system_.to_cart_state(point.z, point.y, time + step_size);
-    require_finite_speeds(name_, time, step_size, next);
+    require_finite_speeds(name_, time, step_size, next, point.z);
     ++counted.steps;
     state = next;
     statistics = counted;
@@ -107,7 +107,7 @@ class CarriedCartStepperAdapter final : public CartStepper {
     require_finite_result(name_, time, step_size, point.z, point.y);
     carried_.reduce_angles();
     const CartState next = carried_.output(system_, time + step_size);
-    require_finite_speeds(name_, time, step_size, next);
+    require_finite_speeds(name_, time, step_size, next, point.z);
     carried_.valid = true;
     ++counted.steps;
     state = next;

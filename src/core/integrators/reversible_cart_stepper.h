@@ -108,7 +108,7 @@ class ReversibleCartStepperAdapter final : public CartStepper {
     const auto& point = output_.point;
     stepper_checks::require_finite_result(name_, time, step_size, point.z, point.y);
     const CartState next = output_.output(system_, target);
-    stepper_checks::require_finite_speeds(name_, time, step_size, next);
+    stepper_checks::require_finite_speeds(name_, time, step_size, next, point.z);
     remember_commands();
     valid_ = true;
     ++counted.steps;

@@ -56,12 +56,21 @@ inline void require_finite_result(const std::string& integrator, double time, do
     if (!std::isfinite(y(i))) throw_non_finite(integrator, time, step_size, kPassiveNames[i], y(i));
   }
 }
-inline void require_finite_speeds(const std::string& integrator, double time, double step_size, const CartState& next) {
+/// The same for the quasi-velocities of `next`, and for its kinetic energy T* = ½ (p1 ω1 + p2 ω2)
+/// with the momenta p of `z`: a step that blew up (an implicit solve that settled on a spurious root
+/// far from the motion) can leave every coordinate finite and T* beyond the largest double.
+inline void require_finite_speeds(const std::string& integrator, double time, double step_size, const CartState& next,
+                                  const Eigen::Matrix<double, kBirkhoffianSize, 1>& z) {
   if (!std::isfinite(next.forward_speed)) {
     throw_non_finite(integrator, time, step_size, "forward_speed omega1 (singular mass matrix?)", next.forward_speed);
   }
   if (!std::isfinite(next.steering_rate)) {
     throw_non_finite(integrator, time, step_size, "steering_rate omega2 (singular mass matrix?)", next.steering_rate);
+  }
+  const double kinetic_energy =
+      0.5 * (z(kForwardMomentumIndex) * next.forward_speed + z(kSteeringMomentumIndex) * next.steering_rate);
+  if (!std::isfinite(kinetic_energy)) {
+    throw_non_finite(integrator, time, step_size, "kinetic energy T* (the step blew up)", kinetic_energy);
   }
 }
 

@@ -15,9 +15,13 @@
 //  - starting values from the stage derivatives of the steps before (memory): the polynomial through
 //    the last recorded (time, F) points, evaluated at the new stage times (eq. (B.32)); without memory
 //    from one explicit evaluation Zᵢ = cᵢh F(w, tₖ);
-//  - simplified Newton with one Jacobian J = ∂ẇ/∂w (AD) kept across iterations and across steps
-//    while the iteration contracts by ≥ 20× per iteration; plain fixed-point iteration contracts only
-//    by ~h‖A‖‖J‖, which near the jackknife took 7–9 iterations a step, Newton takes 2–3;
+//  - simplified Newton with one Jacobian J = ∂ẇ/∂w (System::darboux_jacobian in closed form, else
+//    AD) kept across iterations and across steps while the iteration contracts by ≥ 500× per
+//    iteration; the inverse of I − hA ⊗ J in factored form through its Kronecker structure
+//    (kronecker_newton.h, eqs. (B.38)–(B.39)), so that renewing it costs about one iteration; plain
+//    fixed-point iteration contracts only by ~h‖A‖‖J‖, which near the jackknife took 7–9 iterations;
+//  - the s stage rates of an iteration in one call where the system has darboux_rates_stages (the
+//    cart: one vector sin/cos for all stages, vector_math.h);
 //  - stop per component when its largest stage change is predicted to fall below half an ulp, or no
 //    component's change reaches a new minimum twice in a row (IRKGL16's round-off rule): componentwise,
 //    scale-free, unbiased; coordinates the rates never read (System::kCyclicMask, the cart's arc
@@ -55,7 +59,9 @@
 #include "birkhoff_cart/core/integrators/cart_stepper.h"
 #include "birkhoff_cart/core/integrators/error_estimate.h"
 #include "birkhoff_cart/core/integrators/gauss_legendre_tableau.h"
+#include "birkhoff_cart/core/integrators/kronecker_newton.h"
 #include "birkhoff_cart/core/integrators/newton.h"
+#include "birkhoff_cart/core/integrators/small_inverse.h"
 
 namespace birkhoff_cart {
 
@@ -72,6 +78,56 @@ struct PassiveCouplingDepth : std::integral_constant<int, -1> {};
 template <class System>
 struct PassiveCouplingDepth<System, std::void_t<decltype(System::kPassiveCouplingDepth)>>
     : std::integral_constant<int, System::kPassiveCouplingDepth> {};
+
+/// Does the system give the rates of the passive coordinates g reads, alone
+/// (System::passive_coupling_rates(z, t))? Then the coupling sweeps evaluate only those.
+template <class System, class = void>
+struct HasPassiveCouplingRates : std::false_type {};
+template <class System>
+struct HasPassiveCouplingRates<System,
+                               std::void_t<decltype(std::declval<const System&>().passive_coupling_rates(
+                                   std::declval<const StateVector<System, double>&>(), std::declval<const double&>()))>>
+    : std::true_type {};
+
+/// Does the system give J = ∂ẇ/∂w in closed form (System::darboux_jacobian(w, t))? Else AD.
+template <class System, class = void>
+struct HasDarbouxJacobian : std::false_type {};
+template <class System>
+struct HasDarbouxJacobian<System, std::void_t<decltype(std::declval<const System&>().darboux_jacobian(
+                                      std::declval<const StateVector<System, double>&>(), 0.0))>> : std::true_type {};
+
+/// J = ∂ẇ/∂w at (w, t): the system's closed form when it has one, else forward-mode AD of ẇ.
+template <class System>
+Eigen::Matrix<double, System::kDimension, System::kDimension> darboux_jacobian(const System& system,
+                                                                             const StateVector<System, double>& w,
+                                                                             double t) {
+  constexpr int n = System::kDimension;
+  if constexpr (HasDarbouxJacobian<System>::value) {
+    return system.darboux_jacobian(w, t);
+  } else {
+    using JetN = newton_detail::JacobianJet<n>;
+    Eigen::Matrix<JetN, n, 1> w_jet;
+    for (int k = 0; k < n; ++k) {
+      w_jet(k).value() = w(k);
+      w_jet(k).derivatives() = Eigen::Matrix<double, n, 1, Eigen::DontAlign>::Unit(k);
+    }
+    const Eigen::Matrix<JetN, n, 1> rate = system.darboux_rates(w_jet, JetN(t));
+    Eigen::Matrix<double, n, n> jacobian;
+    for (int k = 0; k < n; ++k) jacobian.row(k) = rate(k).derivatives().transpose();
+    return jacobian;
+  }
+}
+
+/// Does the system evaluate ẇ at all stages of a step at once (System::darboux_rates_stages; the
+/// vector path of vector_math.h)?
+template <class System, int Stages, class = void>
+struct HasStageRates : std::false_type {};
+template <class System, int Stages>
+struct HasStageRates<System, Stages,
+                     std::void_t<decltype(std::declval<const System&>().darboux_rates_stages(
+                         std::declval<const std::array<StateVector<System, double>, Stages>&>(),
+                         std::declval<const std::array<double, Stages>&>(),
+                         std::declval<std::array<StateVector<System, double>, Stages>&>()))>> : std::true_type {};
 
 template <class System, class = void>
 struct LinearChart : std::false_type {};
@@ -118,7 +174,7 @@ struct CollocationMemory {
   int cached = 0;                                            ///< entries of the two arrays below in use
   int next_slot = 0;                                         ///< round-robin replacement
   std::array<double, kCachedStepSizes> cached_step{};        ///< h [s] of each cached inverse
-  std::array<StageMatrix, kCachedStepSizes> cached_inverse;  ///< (I − h A ⊗ J)⁻¹
+  std::array<KroneckerNewtonInverse<kDimension, Stages>, kCachedStepSizes> cached_inverse;  ///< (I − h A ⊗ J)⁻¹
 
   // First same as last (the local error estimate, eq. (B.37)): F(w⁺, tₖ₊₁) of the last step stands
   // in for the next step's F(w, tₖ) while that step starts from the same point and time.
@@ -299,16 +355,31 @@ class GaussCollocation {
       // polynomial's increments, not ∫P: for s = 1 the stage sees F at the midpoint only).
       std::array<double, kMaxGaussStages> points{};  // memory times in units of h from tₖ
       for (int m = 0; m < memory.count; ++m) points[m] = (memory.times[m] - t) / h;
+      // Fⱼ⁽⁰⁾ = Σₘ Lₘ(cⱼ) Fₘ with the Lagrange basis Lₘ of the points, in double (a starting guess
+      // needs no more), and plain loops over the components.
+      std::array<std::array<double, kMaxGaussStages>, Stages> basis{};  // Lₘ(cⱼ)
       for (int j = 0; j < Stages; ++j) {
-        const std::array<double, kMaxGaussStages> basis = lagrange_basis_values(points, memory.count, tableau.nodes[j]);
-        W rate = W::Constant(S(0.0));
-        for (int m = 0; m < memory.count; ++m) rate += basis[m] * memory.rates[m].template cast<S>();
-        stage_rates[j] = rate;
+        for (int m = 0; m < memory.count; ++m) {
+          double value = 1.0;
+          for (int q = 0; q < memory.count; ++q) {
+            if (q != m) value *= (tableau.nodes[j] - points[q]) / (points[m] - points[q]);
+          }
+          basis[j][m] = value;
+        }
+      }
+      for (int j = 0; j < Stages; ++j) {
+        for (int k = 0; k < W::RowsAtCompileTime; ++k) {
+          double rate = 0.0;
+          for (int m = 0; m < memory.count; ++m) rate += basis[j][m] * memory.rates[m](k);
+          stage_rates[j](k) = S(rate);
+        }
       }
       for (int i = 0; i < Stages; ++i) {
-        W increment = W::Constant(S(0.0));
-        for (int j = 0; j < Stages; ++j) increment += S(h * tableau.coefficients[i][j]) * stage_rates[j];
-        increments[i] = increment;
+        for (int k = 0; k < W::RowsAtCompileTime; ++k) {
+          S increment = S(0.0);
+          for (int j = 0; j < Stages; ++j) increment += S(h * tableau.coefficients[i][j]) * stage_rates[j](k);
+          increments[i](k) = increment;
+        }
       }
     } else {
       const W rate = system.darboux_rates(w, S(t));
@@ -497,23 +568,15 @@ class GaussCollocation {
     }
   }
 
-  /// (I − h A ⊗ J)⁻¹ for this h from the memory's cache, computing J = ∂ẇ/∂w (AD, at `w`, time
-  /// `t_jacobian`) and the inverse when missing.
+  /// (I − h A ⊗ J)⁻¹ for this h from the memory's cache (kronecker_newton.h), computing J = ∂ẇ/∂w
+  /// (closed form or AD, at `w`, time `t_jacobian`) and the factors when missing.
   template <class System>
-  const typename CollocationMemory<System, Stages>::StageMatrix& newton_inverse(
+  const KroneckerNewtonInverse<System::kDimension, Stages>& newton_inverse(
       const System& system, const GaussLegendreTableau& tableau, const StateVector<System, double>& w,
       double t_jacobian, double h, CollocationMemory<System, Stages>& memory, StepStatistics& statistics) const {
-    constexpr int n = System::kDimension;
     if (!memory.jacobian_valid) {
-      using JetN = newton_detail::JacobianJet<n>;
-      Eigen::Matrix<JetN, n, 1> w_jet;
-      for (int k = 0; k < n; ++k) {
-        w_jet(k).value() = w(k);
-        w_jet(k).derivatives() = Eigen::Matrix<double, n, 1, Eigen::DontAlign>::Unit(k);
-      }
-      const Eigen::Matrix<JetN, n, 1> rate = system.darboux_rates(w_jet, JetN(t_jacobian));
-      ++statistics.rhs_evaluations;  // one AD evaluation (value and Jacobian)
-      for (int k = 0; k < n; ++k) memory.jacobian.row(k) = rate(k).derivatives().transpose();
+      memory.jacobian = collocation_detail::darboux_jacobian(system, w, t_jacobian);
+      ++statistics.rhs_evaluations;  // one evaluation of J (closed form, or AD: value and Jacobian)
       if (!memory.jacobian.allFinite()) fail("met a non-finite Jacobian", t_jacobian - 0.5 * h, 0);
       memory.jacobian_valid = true;
       memory.cached = 0;
@@ -522,19 +585,15 @@ class GaussCollocation {
     for (int slot = 0; slot < memory.cached; ++slot) {
       if (memory.cached_step[slot] == h) return memory.cached_inverse[slot];
     }
-    typename CollocationMemory<System, Stages>::StageMatrix matrix =
-        CollocationMemory<System, Stages>::StageMatrix::Identity();
-    for (int i = 0; i < Stages; ++i) {
-      for (int j = 0; j < Stages; ++j) {
-        matrix.template block<n, n>(i * n, j * n) -= (h * tableau.coefficients[i][j]) * memory.jacobian;
-      }
-    }
     const int slot = memory.next_slot;
     memory.next_slot = (slot + 1) % CollocationMemory<System, Stages>::kCachedStepSizes;
     memory.cached = std::max(memory.cached, slot + 1);
     memory.cached_step[slot] = h;
-    memory.cached_inverse[slot] = matrix.partialPivLu().inverse();
-    if (!memory.cached_inverse[slot].allFinite()) fail("met a singular Newton matrix", t_jacobian - 0.5 * h, 0);
+    if (!memory.cached_inverse[slot].build(memory.jacobian, tableau.coefficients, h,
+                                           collocation_detail::CyclicMask<System>::value)) {
+      memory.cached = 0;
+      fail("met a singular Newton matrix", t_jacobian - 0.5 * h, 0);
+    }
     return memory.cached_inverse[slot];
   }
 
@@ -546,27 +605,19 @@ class GaussCollocation {
       const Stages_<System, S>& increments, const std::array<double, Stages>& stage_times, double h, double t,
       StepStatistics& statistics) {
     constexpr int n = System::kDimension;
-    using JetN = newton_detail::JacobianJet<n>;
     using Matrix = typename CollocationMemory<System, Stages>::StageMatrix;
     Matrix matrix = Matrix::Identity();
     for (int j = 0; j < Stages; ++j) {
       const StateVector<System, double> stage = w + values_of(increments[j]);
-      Eigen::Matrix<JetN, n, 1> stage_jet;
-      for (int k = 0; k < n; ++k) {
-        stage_jet(k).value() = stage(k);
-        stage_jet(k).derivatives() = Eigen::Matrix<double, n, 1, Eigen::DontAlign>::Unit(k);
-      }
-      const Eigen::Matrix<JetN, n, 1> rate = system.darboux_rates(stage_jet, JetN(stage_times[j]));
+      const Eigen::Matrix<double, n, n> jacobian = collocation_detail::darboux_jacobian(system, stage, stage_times[j]);
       ++statistics.rhs_evaluations;
-      Eigen::Matrix<double, n, n> jacobian;
-      for (int k = 0; k < n; ++k) jacobian.row(k) = rate(k).derivatives().transpose();
       if (!jacobian.allFinite()) fail("met a non-finite Jacobian", t, 0);
       for (int i = 0; i < Stages; ++i) {
         matrix.template block<n, n>(i * n, j * n) -= (h * tableau.coefficients[i][j]) * jacobian;
       }
     }
-    const Matrix inverse = matrix.partialPivLu().inverse();
-    if (!inverse.allFinite()) fail("met a singular Newton matrix", t, 0);
+    Matrix inverse;
+    if (!invert_small_matrix<n * Stages>(matrix, inverse)) fail("met a singular Newton matrix", t, 0);
     return inverse;
   }
 
@@ -600,7 +651,9 @@ class GaussCollocation {
     // error of where the stages end, so the iteration contracts like Newton's.
     W stage_mean = w;
     for (int i = 0; i < Stages; ++i) stage_mean += increments[i] / S(Stages);
+    // M⁻¹: the factored simplified-Newton inverse, or (after two slow refreshes) Newton's own.
     const auto* inverse = &newton_inverse(system, tableau, values_of(stage_mean), t_jacobian, h, memory, statistics);
+    const typename CollocationMemory<System, Stages>::StageMatrix* exact = nullptr;
     int since_refresh = 0;   // iterations since the Jacobian was last recomputed inside this step
     int refreshes = 0;       // recomputations inside this step
     typename CollocationMemory<System, Stages>::StageMatrix exact_inverse;  // Newton proper, when needed
@@ -614,19 +667,45 @@ class GaussCollocation {
     int growths = 0;
     int stalls = 0;
     int iterations = 0;
+    std::array<std::array<double, Stages>, Stages> step_coefficients;  // h aᵢⱼ [s]
+    for (int i = 0; i < Stages; ++i) {
+      for (int j = 0; j < Stages; ++j) step_coefficients[i][j] = h * tableau.coefficients[i][j];
+    }
     while (true) {
-      for (int j = 0; j < Stages; ++j) {
-        stage_rates[j] = system.darboux_rates(W(w + increments[j]), S(stage_times[j]));
-        ++statistics.rhs_evaluations;
+      if constexpr (std::is_same<S, double>::value && collocation_detail::HasStageRates<System, Stages>::value) {
+        Stages_<System, double> stage_points;
+        for (int j = 0; j < Stages; ++j) stage_points[j] = w + increments[j];
+        system.darboux_rates_stages(stage_points, stage_times, stage_rates);
+        statistics.rhs_evaluations += Stages;
+      } else {
+        for (int j = 0; j < Stages; ++j) {
+          stage_rates[j] = system.darboux_rates(W(w + increments[j]), S(stage_times[j]));
+          ++statistics.rhs_evaluations;
+        }
       }
-      // G(Z)ᵢ = Zᵢ − r − h Σⱼ aᵢⱼ Fⱼ
-      Eigen::Matrix<S, n * Stages, 1> residual;
+      // G(Z)ᵢ = Zᵢ − r − h Σⱼ aᵢⱼ Fⱼ. (Plain loops here and below: Eigen's expressions on these
+      // 4-vectors were not inlined in this function, and cost more than their arithmetic.)
+      std::array<S, n * Stages> residual;
       for (int i = 0; i < Stages; ++i) {
-        W g = increments[i] - w_remainder;
-        for (int j = 0; j < Stages; ++j) g -= S(h * tableau.coefficients[i][j]) * stage_rates[j];
-        residual.template segment<n>(i * n) = g;
+        for (int k = 0; k < n; ++k) {
+          S g = increments[i](k) - w_remainder(k);
+          for (int j = 0; j < Stages; ++j) g -= S(step_coefficients[i][j]) * stage_rates[j](k);
+          residual[i * n + k] = g;
+        }
       }
       ++iterations;
+      // M⁻¹ G(Z), column by column (the inverse is column-major).
+      std::array<S, n * Stages> correction;
+      correction.fill(S(0.0) * residual[0]);
+      if (exact == nullptr) {
+        inverse->apply(residual, correction);
+      } else {
+        for (int c = 0; c < n * Stages; ++c) {  // column by column (column-major)
+          const S& residual_c = residual[c];
+          const double* column = exact->data() + static_cast<std::ptrdiff_t>(c) * n * Stages;
+          for (int r = 0; r < n * Stages; ++r) correction[r] += column[r] * residual_c;
+        }
+      }
       // Z ← Z − M⁻¹ G(Z), and the stop rule's measures.
       bool improved = false;
       bool any_change = false;
@@ -636,9 +715,7 @@ class GaussCollocation {
       change.fill(0.0);
       for (int i = 0; i < Stages; ++i) {
         for (int k = 0; k < n; ++k) {
-          S correction = S(0.0) * residual(0);
-          for (int c = 0; c < n * Stages; ++c) correction += (*inverse)(i * n + k, c) * residual(c);
-          const S updated = increments[i](k) - correction;
+          const S updated = increments[i](k) - correction[i * n + k];
           change[k] = std::max(change[k], collocation_detail::change_magnitude(updated, increments[i](k)));
           increments[i](k) = updated;
         }
@@ -683,9 +760,10 @@ class GaussCollocation {
           stage_mean = w;
           for (int i = 0; i < Stages; ++i) stage_mean += increments[i] / S(Stages);
           inverse = &newton_inverse(system, tableau, values_of(stage_mean), t_jacobian, h, memory, statistics);
+          exact = nullptr;
         } else {
           exact_inverse = stage_newton_inverse(system, tableau, values_of(w), increments, stage_times, h, t, statistics);
-          inverse = &exact_inverse;
+          exact = &exact_inverse;
         }
         since_refresh = 0;
         growths = 0;
@@ -695,10 +773,16 @@ class GaussCollocation {
       if (iterations >= settings_.max_iterations) fail("did not converge (Newton)", t, iterations);
     }
     if (refreshes >= 2) memory.forget_jacobian();  // the per-stage matrix is this step's only
-    // Keep J for the next step only while it contracts fast (≤ 0.05 per iteration).
-    // (Measured on the whirl, instructions per step: refreshing at 0.02, 0.01 or 0.003 costs more
-    // in AD Jacobians and inverses than the iterations it saves.)
-    if (worst_contraction > 0.05) memory.forget_jacobian();
+    // Keep J for the next step only while it contracts fast enough. A new J costs one closed-form
+    // evaluation and the Kronecker factors (kronecker_newton.h), about one iteration's work; a stale
+    // one costs iterations. On the 1000 s whirl (CPU, min of 3 runs), keeping J up to a contraction
+    // of 0.05, 0.005, 0.001 or 0 (a new J every step) took 5.7, 4.6, 4.0, 3.5 iterations a step
+    // with gauss8 at h = 0.025 s and 66.7, 62.9, 64.3, 73.1 ms; gauss4 at 0.01 s: 124, 120, 117,
+    // 125 ms; gauss8 at 0.1 s: 28.2, 27.5, 26.9, 26.9 ms. One stage (birkhoff2 and the compositions
+    // built on it) keeps 0.05: with a J renewed more often, birkhoff4's backward sub-step of −0.34 s
+    // at h = 0.2 s settled on a spurious root and blew up (hard_cases_test, LargeSteps).
+    constexpr double kKeptJacobianContraction = Stages == 1 ? 0.05 : 0.005;
+    if (worst_contraction > kKeptJacobianContraction) memory.forget_jacobian();
     return iterations;
   }
 
@@ -726,8 +810,17 @@ class GaussCollocation {
       constexpr int kMaxSweeps = 50;
       std::array<Y, Stages> passive_stages;
       passive_stages.fill(y);
+      // With a known depth d and the coupling rates alone (System::passive_coupling_rates), sweeps
+      // 0 … d − 1 only carry the coordinates g reads to their stage values; sweep d is the full one.
+      constexpr bool kCouplingSweeps = kDepth >= 0 && collocation_detail::HasPassiveCouplingRates<System>::value;
       for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
         for (int j = 0; j < Stages; ++j) {
+          if constexpr (kCouplingSweeps) {
+            if (sweep < kDepth) {
+              passive_rates[j] = system.passive_coupling_rates(stage_points[j], S(stage_times[j]));
+              continue;
+            }
+          }
           passive_rates[j] = passive_coordinate_rates(system, stage_points[j], passive_stages[j], S(stage_times[j]));
           ++statistics.passive_evaluations;
         }

@@ -1,0 +1,41 @@
+// sin and cos of several angles at once, for the stage right-hand sides of the Gauss collocation
+// members (gauss_collocation.h, cart_birkhoffian.h darboux_rates_stages): the s ≤ 4 steering angles
+// of one Newton iteration's stages go through one vector call of glibc's libmvec (_ZGVdN4v_sin,
+// _ZGVdN4v_cos: AVX2, within 4 ulp) instead of s scalar sincos calls, which the iteration waits on
+// one after another. docs/integrators.md, "Stage evaluation".
+//
+// Two paths, chosen at run time (the build runs on any x86-64):
+//  - vector: the AVX2 libmvec call, where the CPU has AVX2 and FMA;
+//  - scalar: std::sin and std::cos lane by lane, bit-identical to the members' scalar right-hand side.
+// The default is vector where the CPU allows it; the environment variable
+// BIRKHOFF_CART_STAGE_EVALUATION=scalar|vector, read once at start, or set_stage_evaluation
+// (tests) chooses. The two paths agree to a few ulp per angle; trajectories to round-off
+// (test/unit/stage_evaluation_test.cpp).
+#pragma once
+
+#include <string>
+
+namespace birkhoff_cart {
+
+/// The most angles one call takes [-].
+constexpr int kMaxVectorLanes = 4;
+
+enum class StageEvaluation { kScalar, kVector };
+
+/// "scalar" or "vector".
+std::string to_string(StageEvaluation evaluation);
+
+/// Does this CPU run the vector path (AVX2 and FMA on x86-64)?
+bool vector_stage_evaluation_available();
+
+/// The path in use now.
+StageEvaluation stage_evaluation();
+
+/// Chooses the path for the whole process; std::invalid_argument (naming the CPU's lack) when the
+/// vector path is asked for where it cannot run. Not thread-safe against running integrations.
+void set_stage_evaluation(StageEvaluation evaluation);
+
+/// sines[i] = sin(angles[i]), cosines[i] = cos(angles[i]) for i < count ≤ kMaxVectorLanes [rad → -].
+void sin_cos_lanes(const double* angles, int count, double* sines, double* cosines);
+
+}  // namespace birkhoff_cart
