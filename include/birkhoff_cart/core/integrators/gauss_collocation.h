@@ -269,6 +269,9 @@ class GaussCollocation {
   static constexpr int kStages = Stages;
   static constexpr int kOrder = 2 * Stages;
   static constexpr bool kSymmetric = true;
+  /// The s stage rates of an iteration in one call (System::darboux_rates_stages: the vector path
+  /// of vector_math.h) from two stages on; one stage gains nothing from a 4-lane call.
+  static constexpr bool kEvaluatesStagesTogether = Stages >= 2;
   template <class System>
   using Memory = CollocationMemory<System, Stages>;
   static const char* name() {
@@ -672,7 +675,8 @@ class GaussCollocation {
       for (int j = 0; j < Stages; ++j) step_coefficients[i][j] = h * tableau.coefficients[i][j];
     }
     while (true) {
-      if constexpr (std::is_same<S, double>::value && collocation_detail::HasStageRates<System, Stages>::value) {
+      if constexpr (std::is_same<S, double>::value && kEvaluatesStagesTogether &&
+                    collocation_detail::HasStageRates<System, Stages>::value) {
         Stages_<System, double> stage_points;
         for (int j = 0; j < Stages; ++j) stage_points[j] = w + increments[j];
         system.darboux_rates_stages(stage_points, stage_times, stage_rates);
