@@ -16,7 +16,7 @@
 //    the last recorded (time, F) points, evaluated at the new stage times (eq. (B.32)); without memory
 //    from one explicit evaluation Zᵢ = cᵢh F(w, tₖ);
 //  - simplified Newton with one Jacobian J = ∂ẇ/∂w (System::darboux_jacobian in closed form, else
-//    AD) kept across iterations and across steps while the iteration contracts by ≥ 500× per
+//    AD) kept across iterations and across steps while the iteration contracts by ≥ 200× (one stage: 20×) per
 //    iteration; the inverse of I − hA ⊗ J in factored form through its Kronecker structure
 //    (kronecker_newton.h, eqs. (B.38)–(B.39)), so that renewing it costs about one iteration; plain
 //    fixed-point iteration contracts only by ~h‖A‖‖J‖, which near the jackknife took 7–9 iterations;
