@@ -10,6 +10,8 @@
 #include <optional>
 #include <sstream>
 
+#include <diagnostic_msgs/DiagnosticArray.h>
+
 #include "birkhoff_cart/core/run_summary.h"
 #include "birkhoff_cart/ros/accuracy_reporting.h"
 
@@ -29,6 +31,7 @@ CartSimReports::CartSimReports(const RunView& run, ros::NodeHandle& node, ros::N
     : run_(run), updater_(node, private_node) {
   updater_.setHardwareID("birkhoff_cart/" + run_.simulation.scene().name);
   updater_.add("simulation", this, &CartSimReports::produce_diagnostics);
+  diagnostics_listeners_ = node.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 1);
 }
 
 void CartSimReports::publish_diagnostics() { updater_.force_update(); }

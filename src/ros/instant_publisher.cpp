@@ -59,6 +59,15 @@ void InstantPublisher::publish_clock(double time) {
   if (ros::Time::isSimTime()) ros::Time::setNow(clock_message_.clock);
 }
 
+bool InstantPublisher::listened() const {
+  // An unadvertised publisher (/clock, /tf switched off) counts 0.
+  for (const ros::Publisher* publisher : {&odometry_publisher_, &ground_truth_publisher_, &joint_state_publisher_,
+                                          &integration_error_publisher_, &clock_publisher_, &transform_publisher_}) {
+    if (publisher->getNumSubscribers() > 0) return true;
+  }
+  return false;
+}
+
 void InstantPublisher::publish(const Simulation& simulation, const Diagnostics& diagnostics,
                                const AccuracyGuard& guard, double wall_time_per_step,
                                const OdometryEstimate* estimate, RunRecord* record) {

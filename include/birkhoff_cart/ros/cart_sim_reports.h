@@ -49,12 +49,17 @@ class CartSimReports {
   void report_progress();
   /// The summary paragraph of a run that ended with `outcome` ("finished", "step failure: ...").
   void write_summary(const std::string& outcome);
+  /// Someone subscribes to /diagnostics.
+  bool diagnostics_listened() const { return diagnostics_listeners_.getNumSubscribers() > 0; }
 
  private:
   void produce_diagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   RunView run_;
   diagnostic_updater::Updater updater_;
+  /// A second handle on the updater's /diagnostics (same topic, same publication in this process),
+  /// which never publishes: the updater does not tell its subscribers.
+  ros::Publisher diagnostics_listeners_;
   std::uint64_t rejections_seen_ = 0;  ///< rejected commands already reported
 };
 
