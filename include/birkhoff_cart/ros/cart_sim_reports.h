@@ -42,7 +42,8 @@ class CartSimReports {
   /// /diagnostics through a diagnostic_updater on `node` (its parameters under `private_node`).
   CartSimReports(const RunView& run, ros::NodeHandle& node, ros::NodeHandle& private_node);
 
-  /// Publishes the /diagnostics status now (the node calls it every ~diagnostic_period of scene time).
+  /// Publishes the /diagnostics status now (the node calls it every ~diagnostic_period of scene
+  /// time); builds it only when someone subscribes.
   void publish_diagnostics();
   /// Fast mode: at most once per second of wall time, one log line with the scene time, the percent
   /// of the run done and the real-time factor since the last line.
