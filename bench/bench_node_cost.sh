@@ -12,9 +12,21 @@
 # steadier measure of cost; node/core = node's cost over cart_simulate's.
 # Starts its own roscore on a free port, stops only what it started, removes its scratch directory.
 #
-# Usage: bench/bench_node_cost.sh [WORKSPACE]     (default .ws; must have cart_sim built)
+# --default-scene-only [N]: only the default scene as shipped with its bag on, beside cart_simulate,
+# N times (default 5) in turns (node then core, core then node, ...), so that both see the same load:
+# per run the node's loop factor (its summary) and its process's, cart_simulate's (scene time over
+# its process's wall time), the CPU time of each per second of scene time, the ratio core/node and
+# the load average; then the medians. About 3 s a pair.
+#
+# Usage: bench/bench_node_cost.sh [--default-scene-only [N]] [WORKSPACE]   (default .ws; must have cart_sim built)
 set -euo pipefail
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+default_scene_only=0
+if [ "${1:-}" = "--default-scene-only" ]; then
+  default_scene_only=5
+  shift
+  if [[ "${1:-}" =~ ^[1-9][0-9]*$ ]]; then default_scene_only="$1"; shift; fi
+fi
 workspace="${1:-$repo/.ws}"
 export PATH="/usr/bin:/bin:$PATH"
 set +u
@@ -43,6 +55,11 @@ if ! kill -0 "$roscore_pid" 2>/dev/null; then
   echo "bench_node_cost.sh: roscore on port $port did not start" >&2
   exit 1
 fi
+# rosout reads /use_sim_time once, as it starts, and under sim time subscribes to /clock: every
+# /clock the node publishes is then sent to it over TCP (about 2.6 us of the node's time loop per
+# instant, and rosout woken 30 000 times a run). The master answers before rosout is up, so set
+# /use_sim_time only once rosout subscribes to /rosout (its start is over): no run has that listener.
+for _ in $(seq 100); do rostopic info /rosout 2>/dev/null | grep -q '^ \* /rosout ' && break; sleep 0.1; done
 rosparam set /use_sim_time true
 
 cpu_ticks() { awk '{print $14 + $15}' "/proc/$1/stat"; }  # utime + stime [clock ticks]
@@ -91,7 +108,71 @@ fast_table() {  # $1 title; three runs of node with bag, without, and cart_simul
   echo "  bag: $(ls -l "$work/node.bag" | awk '{print $5}') bytes; $(rosbag info "$work/node.bag" | grep -E '^(messages|compression)' | tr -s ' ' | tr '\n' ';')"
 }
 
+# The default scene as shipped, node with its bag against cart_simulate, in turns (--default-scene-only).
+# CPU time from wait4's rusage with its microseconds (the kernel's exact run time of all threads;
+# /usr/bin/time prints it to 10 ms, 4 % of these runs).
+precise_timed() {  # $1 output file for "wall cpu" [s]; the rest: the command
+  local out="$1"; shift
+  /usr/bin/python3 -c '
+import os, subprocess, sys, time
+start = time.monotonic()
+child = subprocess.Popen(sys.argv[2:], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+_, status, usage = os.wait4(child.pid, 0)
+wall = time.monotonic() - start
+open(sys.argv[1], "w").write("%.6f %.6f\n" % (wall, usage.ru_utime + usage.ru_stime))
+' "$out" "$@"
+}
+node_pair_run() {  # $1 label -> "wall loop_rtf cpu"
+  rosparam delete /cart_sim > /dev/null 2>&1 || true
+  precise_timed "$work/$1.time" "$bin/cart_sim" __name:=cart_sim _scene:="$scene" _fast:=true _publish_rate:=100 \
+    _duration:=$duration _summary_path:="$work/$1.summary" _bag_path:="$work/pair.bag"
+  rm -f "$work/pair.bag"
+  local rtf; rtf=$(grep -o 'real-time factor [0-9.e+]*' "$work/$1.summary" | awk '{print $3}'); rtf="${rtf%.}"
+  awk -v rtf="$rtf" '{printf "%s %s %s", $1, rtf, $2}' "$work/$1.time"
+}
+core_pair_run() {  # -> "wall cpu"
+  precise_timed "$work/core.time" "$bin/cart_simulate" --quiet --scene "$scene" --output-rate 100 --duration $duration \
+    --output "$work/core.csv"
+  cat "$work/core.time"
+}
+median() { sort -g | awk '{v[NR] = $1} END {print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2}'; }
+default_scene_pairs() {  # $1 repetitions
+  echo "default scene as shipped (birkhoff_gauss4 at h = 10 ms, dopri5 shadow reference), 100 Hz, $duration s, bag on; $(nproc) cores"
+  printf "%-3s | %-40s | %-26s | %-17s | %s\n" run "node: loop x (process x) / CPU ms per s" "cart_simulate: x / CPU ms per s" \
+    "core/node: x, CPU" "load (1 min)"
+  local values="$work/pairs.values"
+  : > "$values"
+  for repetition in $(seq "$1"); do
+    local node_result core_result
+    if ((repetition % 2)); then
+      node_result="$(node_pair_run "pair_$repetition")"
+      core_result="$(core_pair_run)"
+    else
+      core_result="$(core_pair_run)"
+      node_result="$(node_pair_run "pair_$repetition")"
+    fi
+    read -r node_wall node_rtf node_cpu <<< "$node_result"
+    read -r core_wall core_cpu <<< "$core_result"
+    awk -v nw="$node_wall" -v nr="$node_rtf" -v nc="$node_cpu" -v cw="$core_wall" -v cc="$core_cpu" -v T="$duration" \
+      'BEGIN {print nr, 1000 * nc / T, T / cw, 1000 * cc / T, (T / cw) / nr, cc / nc}' >> "$values"
+    awk -v r="$repetition" -v nw="$node_wall" -v nr="$node_rtf" -v nc="$node_cpu" -v cw="$core_wall" -v cc="$core_cpu" \
+      -v T="$duration" -v load="$(cut -d' ' -f1 /proc/loadavg)" \
+      'BEGIN {printf "%-3s | %6.0fx (%5.0fx) / %6.3f                  | %6.0fx / %6.3f            | %4.2f, %4.2f        | %s\n",
+              r, nr, T / nw, 1000 * nc / T, T / cw, 1000 * cc / T, (T / cw) / nr, cc / nc, load}'
+  done
+  local column
+  for column in 1 2 3 4 5 6; do awk -v k=$column '{print $k}' "$values" | median; done | tr '\n' ' ' |
+    awk '{printf "median: node loop %.0fx, %.3f CPU ms per s; cart_simulate %.0fx, %.3f CPU ms per s; core/node %.2f (x), %.2f (CPU)\n",
+          $1, $2, $3, $4, $5, $6}'
+}
+
 echo "load before: $(cat /proc/loadavg)"
+if ((default_scene_only)); then
+  stepping=""; core_stepping=""
+  default_scene_pairs "$default_scene_only"
+  echo "load after:  $(cat /proc/loadavg)"
+  exit 0
+fi
 fast_table "default scene, birkhoff2 at h = 1 ms , 100 Hz, $duration s:"
 read -r none_wall none_rtf none_cpu <<< "$(node_fast "bag_none" "_bag_path:=$work/node_none.bag _bag_compression:=none")"
 echo "  bag uncompressed (~bag_compression none): wall $none_wall s (loop ${none_rtf}x) / CPU $none_cpu s; $(ls -l "$work/node_none.bag" | awk '{print $5}') bytes"

@@ -18,6 +18,14 @@ void publish_shared(const ros::Publisher& publisher, const Message& message) {
   publisher.publish(boost::make_shared<Message>(message));
 }
 
+/// Publishes `message` when someone subscribes. roscpp drops it without a subscriber anyway, but
+/// only after its typed publish() has built a std::string of the md5sum (an allocation) and looked
+/// the topic up under its global lock; the count is that look-up alone.
+template <class Message>
+void publish_if_heard(const ros::Publisher& publisher, const Message& message) {
+  if (publisher.getNumSubscribers() > 0) publisher.publish(message);
+}
+
 }  // namespace
 
 InstantPublisher::InstantPublisher(ros::NodeHandle& node, ros::NodeHandle& private_node,
@@ -53,30 +61,39 @@ InstantPublisher::InstantPublisher(ros::NodeHandle& node, ros::NodeHandle& priva
 void InstantPublisher::publish_clock(double time) {
   if (!parameters_.publish_clock) return;
   clock_message_.clock = ros_conversions::to_ros_time(time);
-  clock_publisher_.publish(clock_message_);
+  publish_if_heard(clock_publisher_, clock_message_);
   // This process does not hear its own /clock (main() remaps roscpp's subscription away): its ROS
   // time (log stamps, diagnostics) is set here instead.
   if (ros::Time::isSimTime()) ros::Time::setNow(clock_message_.clock);
+}
+
+bool InstantPublisher::listened() const {
+  // An unadvertised publisher (/clock, /tf switched off) counts 0.
+  for (const ros::Publisher* publisher : {&odometry_publisher_, &ground_truth_publisher_, &joint_state_publisher_,
+                                          &integration_error_publisher_, &clock_publisher_, &transform_publisher_}) {
+    if (publisher->getNumSubscribers() > 0) return true;
+  }
+  return false;
 }
 
 void InstantPublisher::publish(const Simulation& simulation, const Diagnostics& diagnostics,
                                const AccuracyGuard& guard, double wall_time_per_step,
                                const OdometryEstimate* estimate, RunRecord* record) {
   // The messages are members filled in place (InstantMessages): nothing is allocated here once
-  // they hold their strings. roscpp 1.15's typed publish() still builds a std::string of the
-  // md5sum at every call (ros/publisher.h), and serializes into a buffer of its own for a topic
-  // with subscribers.
+  // they hold their strings. A topic without subscribers is not handed to roscpp at all: its typed
+  // publish() builds a std::string of the md5sum at every call (ros/publisher.h), and serializes
+  // into a buffer of its own for a topic with subscribers.
   messages_.fill(simulation, diagnostics, guard, wall_time_per_step, estimate);
   // The controllers' inputs as shared messages (zero-copy in a nodelet manager).
   publish_shared(ground_truth_publisher_, messages_.ground_truth);
   publish_shared(odometry_publisher_, messages_.odometry);
   publish_shared(joint_state_publisher_, messages_.joints);
-  integration_error_publisher_.publish(messages_.integration_error);
+  publish_if_heard(integration_error_publisher_, messages_.integration_error);
   // odom → base_link, once per stamp; also into the bag, so a replay in rviz places the cart.
   const ros::Time stamp = messages_.odometry.header.stamp;
   const bool transform_sent = parameters_.publish_tf && stamp != last_transform_stamp_;
   if (transform_sent) {
-    transform_publisher_.publish(messages_.transforms);
+    publish_if_heard(transform_publisher_, messages_.transforms);
     last_transform_stamp_ = stamp;
   }
   if (!record) return;

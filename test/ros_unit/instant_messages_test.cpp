@@ -5,8 +5,8 @@
 // of this thread. After a warm-up (the messages hold their strings; every ring slot has held its
 // message type once) the count over many instants must be zero. The bag's writer thread (chunk
 // bookkeeping) and roscpp's publish (its typed publish() builds a std::string of the md5sum at
-// every call, and serializes for a topic with subscribers) are outside this path and not counted. Also: filled messages equal the to_*
-// conversions. No master needed.
+// every call, and serializes for a topic with subscribers) are outside this path and not counted. Also: filled messages
+// (odometry, ground truth, joint states, the transform, integration_error) equal the to_* conversions. No master needed.
 #include <gtest/gtest.h>
 
 #include <stdlib.h>
@@ -139,6 +139,12 @@ TEST(InstantMessages, FilledMessagesEqualTheConversions) {
   const CartState& state = simulation.state();
   const nav_msgs::Odometry odometry = ros_conversions::to_odometry(state, simulation.model(), prefixed());
   EXPECT_EQ(messages.odometry, odometry);
+  // The ground truth: the exact state in the world frame, covariances 0 (its pose and twist are
+  // odom's, copied rather than computed again).
+  ros_conversions::FrameNames world_frames = prefixed();
+  world_frames.odom = world_frames.world;
+  const ros_conversions::OdometryCovariance exact{{0, 0, 0, 0, 0, 0}, {0, 0, 0, 0, 0, 0}};
+  EXPECT_EQ(messages.ground_truth, ros_conversions::to_odometry(state, simulation.model(), world_frames, exact));
   const sensor_msgs::JointState joints = ros_conversions::to_joint_state(
       state, simulation.model(), ros_conversions::actuator_efforts(simulation), kPrefix);
   EXPECT_EQ(messages.joints, joints);

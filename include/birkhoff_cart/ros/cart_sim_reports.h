@@ -42,19 +42,25 @@ class CartSimReports {
   /// /diagnostics through a diagnostic_updater on `node` (its parameters under `private_node`).
   CartSimReports(const RunView& run, ros::NodeHandle& node, ros::NodeHandle& private_node);
 
-  /// Publishes the /diagnostics status now (the node calls it every ~diagnostic_period of scene time).
+  /// Publishes the /diagnostics status now (the node calls it every ~diagnostic_period of scene
+  /// time); builds it only when someone subscribes.
   void publish_diagnostics();
   /// Fast mode: at most once per second of wall time, one log line with the scene time, the percent
   /// of the run done and the real-time factor since the last line.
   void report_progress();
   /// The summary paragraph of a run that ended with `outcome` ("finished", "step failure: ...").
   void write_summary(const std::string& outcome);
+  /// Someone subscribes to /diagnostics.
+  bool diagnostics_listened() const { return diagnostics_listeners_.getNumSubscribers() > 0; }
 
  private:
   void produce_diagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   RunView run_;
   diagnostic_updater::Updater updater_;
+  /// A second handle on the updater's /diagnostics (same topic, same publication in this process),
+  /// which never publishes: the updater does not tell its subscribers.
+  ros::Publisher diagnostics_listeners_;
   std::uint64_t rejections_seen_ = 0;  ///< rejected commands already reported
 };
 

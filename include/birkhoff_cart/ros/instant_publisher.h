@@ -40,6 +40,9 @@ class InstantPublisher {
 
   /// Subscribers of joint_states (lockstep waits for its controller).
   std::uint32_t joint_state_subscribers() const { return joint_state_publisher_.getNumSubscribers(); }
+  /// Someone subscribes to a topic of an instant (odom, ground_truth, joint_states,
+  /// integration_error, /clock, /tf): the last instant's messages have somewhere to go.
+  bool listened() const;
 
  private:
   static constexpr const char* kTransformTopic = "/tf";
