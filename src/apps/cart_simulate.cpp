@@ -25,6 +25,7 @@
 // failed or the run stopped on an unexpected error (the rows written so far are flushed and kept);
 // 5 the accuracy guard reached ERROR (all rows written; with --on-accuracy-error warn the run
 // exits 0 and the summary still says ERROR).
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -38,8 +39,10 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "birkhoff_cart/core/accuracy_guard.h"
+#include "birkhoff_cart/core/closest_name.h"
 #include "birkhoff_cart/core/integrators/cart_stepper.h"
 #include "birkhoff_cart/core/paper_form_drift.h"
 #include "birkhoff_cart/core/run_summary.h"
@@ -155,6 +158,25 @@ std::map<std::string, std::string> parse_arguments(int argc, char** argv) {
   return values;
 }
 
+/// `names` as "'a' or 'b'", with ", " before the last but one.
+std::string quoted_alternatives(const std::vector<std::string>& names) {
+  std::string text;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (i > 0) text += i + 1 == names.size() ? " or " : ", ";
+    text += "'" + names[i] + "'";
+  }
+  return text;
+}
+
+/// `text` when it is one of `names`; else a UsageError naming the option, the choices and the
+/// closest one to a typo.
+std::string one_of(const std::string& option, const std::string& text, const std::vector<std::string>& names) {
+  if (std::find(names.begin(), names.end(), text) != names.end()) return text;
+  const std::string guess = birkhoff_cart::closest_name(text, names);
+  throw UsageError("option " + option + " must be " + quoted_alternatives(names) + ", got '" + text + "'" +
+                   (guess.empty() ? "" : " (did you mean '" + guess + "'?)"));
+}
+
 /// Scene K of the random family SEED ("SEED:K", both whole numbers ≥ 0), on `base`.
 Scene random_scene(const std::string& text, const Scene& base) {
   const auto colon = text.find(':');
@@ -177,25 +199,19 @@ void apply_overrides(const std::map<std::string, std::string>& arguments, Scene&
     if (option == "--duration") scene.duration = parse_positive(option, text);
     if (option == "--output-rate") scene.output_rate = parse_positive(option, text);
     if (option == "--birkhoffian-form") {
-      if (text != "autonomous" && text != "paper") {
-        throw UsageError("option --birkhoffian-form must be 'autonomous' or 'paper', got '" + text + "'");
-      }
-      scene.integrator.birkhoffian_form = text;
+      scene.integrator.birkhoffian_form =
+          birkhoff_cart::parse_birkhoffian_form(one_of(option, text, birkhoff_cart::birkhoffian_form_names()));
     }
     if (option == "--step-control") {
-      if (text != "fixed" && text != "reversible") {
-        throw UsageError("option --step-control must be 'fixed' or 'reversible', got '" + text + "'");
-      }
-      scene.integrator.step_control = text;
+      scene.integrator.step_control =
+          birkhoff_cart::parse_step_control(one_of(option, text, birkhoff_cart::step_control_names()));
     }
     if (option == "--position-tolerance") scene.integrator.position_tolerance = parse_positive(option, text);
-    if (option == "--on-accuracy-error" && text != "fail" && text != "warn") {
-      throw UsageError("option --on-accuracy-error must be 'fail' or 'warn', got '" + text + "'");
-    }
+    if (option == "--on-accuracy-error") one_of(option, text, {"fail", "warn"});
   }
   // Each tolerance means one thing and is refused where it would be ignored.
   const birkhoff_cart::IntegratorSettings& settings = scene.integrator;
-  const bool reversible = settings.step_control == "reversible";
+  const bool reversible = settings.step_control == birkhoff_cart::StepControl::kReversible;
   if (arguments.count("--tolerance") && settings.name != "dopri5") {
     throw UsageError("option --tolerance is dopri5's local tolerance [-]; " + settings.name + " steps at " +
                      (reversible ? "the reversible step control's steps: give the position error [m] with "

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "birkhoff_cart/core/cart_birkhoffian.h"
+#include "birkhoff_cart/core/closest_name.h"
 #include "birkhoff_cart/core/integrators/birkhoff_symplectic.h"
 #include "birkhoff_cart/core/integrators/carried_state.h"
 #include "birkhoff_cart/core/integrators/dopri5.h"
@@ -123,12 +124,6 @@ class CarriedCartStepperAdapter final : public CartStepper {
   CarriedCartState<System, typename Stepper::template Memory<System>> carried_;
 };
 
-std::string reversible_names() {
-  std::string list;
-  for (const std::string& name : reversible_integrator_names()) list += (list.empty() ? "" : ", ") + name;
-  return list;
-}
-
 template <class Stepper, class System>
 std::unique_ptr<CartStepper> make_adapter(const Stepper& stepper, const CartModel& model, const EffectSet& effects) {
   if constexpr (kCarriesState<Stepper, System>) {
@@ -141,30 +136,22 @@ std::unique_ptr<CartStepper> make_adapter(const Stepper& stepper, const CartMode
 template <class Stepper>
 std::unique_ptr<CartStepper> wrap(const Stepper& stepper, const IntegratorSettings& settings, const CartModel& model,
                                   const EffectSet& effects) {
-  if (settings.birkhoffian_form == "autonomous") {
-    return make_adapter<Stepper, CartAutonomousBirkhoffian>(stepper, model, effects);
-  }
-  if (settings.birkhoffian_form == "paper") {
+  if (settings.birkhoffian_form == BirkhoffianForm::kPaper) {
     return make_adapter<Stepper, CartPaperBirkhoffian>(stepper, model, effects);
   }
-  throw std::invalid_argument("unknown birkhoffian_form '" + settings.birkhoffian_form +
-                              "' (known: autonomous, paper)");
+  return make_adapter<Stepper, CartAutonomousBirkhoffian>(stepper, model, effects);
 }
 
 /// A symmetric Birkhoffian member under reversible step control (reversible_cart_stepper.h).
 template <class Stepper>
 std::unique_ptr<CartStepper> wrap_reversible(const Stepper& stepper, const IntegratorSettings& settings,
                                              const CartModel& model, const EffectSet& effects) {
-  if (settings.birkhoffian_form == "autonomous") {
-    return std::make_unique<ReversibleCartStepperAdapter<Stepper, CartAutonomousBirkhoffian>>(stepper, settings, model,
-                                                                                             effects);
-  }
-  if (settings.birkhoffian_form == "paper") {
+  if (settings.birkhoffian_form == BirkhoffianForm::kPaper) {
     return std::make_unique<ReversibleCartStepperAdapter<Stepper, CartPaperBirkhoffian>>(stepper, settings, model,
                                                                                         effects);
   }
-  throw std::invalid_argument("unknown birkhoffian_form '" + settings.birkhoffian_form +
-                              "' (known: autonomous, paper)");
+  return std::make_unique<ReversibleCartStepperAdapter<Stepper, CartAutonomousBirkhoffian>>(stepper, settings, model,
+                                                                                           effects);
 }
 
 /// The registry's symmetric Birkhoffian members, under reversible step control.
@@ -188,13 +175,7 @@ std::unique_ptr<CartStepper> make_reversible(const IntegratorSettings& settings,
     return wrap_reversible(BirkhoffComposition<KahanLiEightWeights>(collocation), settings, model, effects);
   }
   throw std::invalid_argument("step_control 'reversible' is for the symmetric Birkhoffian members (" +
-                              reversible_names() + "), not '" + name + "'");
-}
-
-std::string known_names() {
-  std::string list;
-  for (const std::string& name : integrator_names()) list += (list.empty() ? "" : ", ") + name;
-  return list;
+                              name_list(reversible_integrator_names()) + "), not '" + name + "'");
 }
 
 }  // namespace
@@ -229,10 +210,7 @@ std::unique_ptr<CartStepper> make_cart_stepper(const IntegratorSettings& setting
   collocation.max_iterations = settings.max_newton_iterations;
   collocation.compensated = settings.compensated_summation;
   collocation.estimate_local_error = settings.local_error_estimate;
-  if (settings.step_control == "reversible") return make_reversible(settings, collocation, model, effects);
-  if (settings.step_control != "fixed") {
-    throw std::invalid_argument("unknown step_control '" + settings.step_control + "' (known: fixed, reversible)");
-  }
+  if (settings.step_control == StepControl::kReversible) return make_reversible(settings, collocation, model, effects);
   if (name == "birkhoff2") return wrap(GaussCollocation<1>(collocation), settings, model, effects);
   if (name == "birkhoff4") return wrap(BirkhoffComposition<TripleJumpWeights>(collocation), settings, model, effects);
   if (name == "birkhoff_gauss4") return wrap(GaussCollocation<2>(collocation), settings, model, effects);
@@ -251,7 +229,7 @@ std::unique_ptr<CartStepper> make_cart_stepper(const IntegratorSettings& setting
   if (name == "rk4") return wrap(ClassicalRungeKutta4(), settings, model, effects);
   if (name == "dopri5") return wrap(DormandPrince5(settings.tolerance), settings, model, effects);
   if (name == "midpoint") return wrap(ImplicitMidpoint(newton), settings, model, effects);
-  throw std::invalid_argument("unknown integrator '" + name + "' (known: " + known_names() + ")");
+  throw std::invalid_argument(unknown_name_message("integrator", name, integrator_names()));
 }
 
 }  // namespace birkhoff_cart
