@@ -10,7 +10,7 @@
 #include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/closest_name.h"
 #include "birkhoff_cart/core/effect_library.h"
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/integrators/integrator_registry.h"
 #include "birkhoff_cart/core/step_schedule.h"
 #include "scene_reader.h"
 
@@ -129,10 +129,10 @@ IntegratorSettings read_integrator(const SceneReader& reader, const YAML::Node& 
   // One meaning per key: `tolerance` is dopri5's local tolerance [-] (kept in the shipped scenes for a
   // switch to dopri5), `position_tolerance` the position error [m] the reversible step control aims at.
   if (settings.step_control == StepControl::kReversible) {
-    const std::vector<std::string> members = reversible_integrator_names();
-    if (std::find(members.begin(), members.end(), settings.name) == members.end()) {
+    if (!integrator_entry(settings.name).reversible()) {
       reader.fail(key + ".step_control", "'reversible' is for the symmetric Birkhoffian members (" +
-                                             name_list(members) + "), not '" + settings.name + "'");
+                                             name_list(reversible_integrator_names()) + "), not '" + settings.name +
+                                             "'");
     }
     if (!reader.has(node, "position_tolerance")) {
       reader.fail(key + ".position_tolerance", "is required with 'step_control: reversible': the position error [m] "
