@@ -25,6 +25,7 @@
 // failed or the run stopped on an unexpected error (the rows written so far are flushed and kept);
 // 5 the accuracy guard reached ERROR (all rows written; with --on-accuracy-error warn the run
 // exits 0 and the summary still says ERROR).
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -38,9 +39,12 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "birkhoff_cart/core/accuracy_guard.h"
+#include "birkhoff_cart/core/closest_name.h"
 #include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/integrators/integrator_registry.h"
 #include "birkhoff_cart/core/paper_form_drift.h"
 #include "birkhoff_cart/core/run_summary.h"
 #include "birkhoff_cart/core/random_scene.h"
@@ -62,41 +66,77 @@ constexpr int kExitStepFailed = 4;
 constexpr int kExitAccuracy = 5;
 constexpr double kProgressPeriod = 1.0;  // at most one progress line per this much wall time [s]
 
-const char* const kUsage =
-    "usage: cart_simulate --scene FILE [--integrator NAME] [--step H] [--tolerance TOL]\n"
-    "                     [--duration T] [--output-rate HZ] [--birkhoffian-form F] [--quiet]\n"
-    "                     [--step-control fixed|reversible] [--position-tolerance M]\n"
-    "                     [--on-accuracy-error fail|warn] [--random-scene SEED:K] --output FILE.csv\n"
-    "       cart_simulate --help | -h | --version\n"
-    "  --scene FILE            scene YAML (config/scenes/*.yaml); it provides every default\n"
-    "  --integrator NAME       birkhoff2, birkhoff4, birkhoff_gauss4, birkhoff_gauss6, birkhoff_gauss8,\n"
-    "                          birkhoff4_suzuki, birkhoff6_kahan_li, birkhoff8_kahan_li, rk2, rk4, dopri5\n"
-    "                          or midpoint (docs/integrators.md)\n"
-    "  --step H                step size [s], > 0; 1/HZ must be a whole multiple of it\n"
-    "  --tolerance TOL         dopri5's absolute and relative local tolerance [-], >= 10 machine epsilon\n"
-    "                          (2.2e-15); refused for the fixed-step members\n"
-    "  --step-control C        fixed (steps of H) or reversible (symmetric Birkhoffian members: their own\n"
-    "                          steps for --position-tolerance, H is then the output step; docs/accuracy.md §4)\n"
-    "  --position-tolerance M  reversible step control: the position error [m] allowed at the horizon\n"
-    "  --duration T            simulated time after the start [s], > 0\n"
-    "  --output-rate HZ        output rows per simulated second [Hz], > 0\n"
-    "  --birkhoffian-form F    autonomous or paper\n"
-    "  --quiet                 no progress lines on stderr\n"
-    "  --random-scene SEED:K   scene K of the seeded random family (a random valid cart, start, step,\n"
-    "                          duration and effects; docs/accuracy.md §3) instead of the file's, which\n"
-    "                          gives the rest (integrator, accuracy guard); the other options still apply\n"
-    "  --on-accuracy-error A   fail (default: exit 5 when the scene's accuracy guard reaches ERROR)\n"
-    "                          or warn (exit 0; the summary still names the quantity)\n"
-    "  --output FILE.csv       where to write t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,\n"
-    "                          local_error_estimate\n"
-    "Every option also takes the form --option=value.\n"
-    "The rows are at t0 + k/HZ from the start to the end, both included; when the duration is not a\n"
-    "whole number of output intervals, a last row is written at the end time t0 + T itself (reached\n"
-    "by one shorter final step). Scene times are limited so that t + H stays exact to ~1e-6 H\n"
-    "(docs/scenes.md). Runs longer than a second report progress on stderr (once a second at most).\n"
-    "Exit status: 0 done; 2 bad arguments; 3 unusable scene, settings or output file;\n"
-    "4 a step failed or the run stopped (the rows written so far are kept); 5 the accuracy guard\n"
-    "reached ERROR (docs/accuracy.md; the summary on stdout names the quantity).\n";
+/// `names` as "a|b" (a usage line), "a or b", "'a' or 'b'" (quoted), with ", " before the last.
+std::string alternatives(const std::vector<std::string>& names, const std::string& separator,
+                         const std::string& last_separator, const std::string& quote = "") {
+  std::string text;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (i > 0) text += i + 1 == names.size() ? last_separator : separator;
+    text += quote + names[i] + quote;
+  }
+  return text;
+}
+
+/// The registry's members, one line each: name, order, symmetric, takes the reversible control,
+/// kind, scheme. The members that take --step-control reversible come first.
+std::string integrator_table() {
+  std::vector<birkhoff_cart::IntegratorEntry> members = birkhoff_cart::integrator_registry();
+  std::stable_partition(members.begin(), members.end(),
+                        [](const birkhoff_cart::IntegratorEntry& member) { return member.reversible(); });
+  std::string table =
+      "Integrators (--integrator NAME; docs/integrators.md). p: the order; symmetric: a time-symmetric\n"
+      "step map; reversible: takes --step-control reversible.\n"
+      "  NAME                p  symmetric  reversible  kind                     scheme\n";
+  for (const birkhoff_cart::IntegratorEntry& member : members) {
+    char line[200];
+    std::snprintf(line, sizeof line, "  %-19s %-2d %-10s %-11s %-24s %s\n", member.name, member.order,
+                  member.symmetric ? "yes" : "no", member.reversible() ? "yes" : "no",
+                  birkhoff_cart::to_string(member.kind), member.description);
+    table += line;
+  }
+  return table;
+}
+
+std::string usage() {
+  using birkhoff_cart::StepControl;
+  const std::string fixed = birkhoff_cart::to_string(StepControl::kFixed);
+  const std::string reversible = birkhoff_cart::to_string(StepControl::kReversible);
+  return "usage: cart_simulate --scene FILE [--integrator NAME] [--step H] [--tolerance TOL]\n"
+         "                     [--duration T] [--output-rate HZ] [--birkhoffian-form F] [--quiet]\n"
+         "                     [--step-control " + alternatives(birkhoff_cart::step_control_names(), "|", "|") +
+         "] [--position-tolerance M]\n"
+         "                     [--on-accuracy-error fail|warn] [--random-scene SEED:K] --output FILE.csv\n"
+         "       cart_simulate --help | -h | --version\n"
+         "  --scene FILE            scene YAML (config/scenes/*.yaml); it provides every default\n"
+         "  --integrator NAME       a member of the registry (below)\n"
+         "  --step H                step size [s], > 0; 1/HZ must be a whole multiple of it\n"
+         "  --tolerance TOL         dopri5's absolute and relative local tolerance [-], >= 10 machine epsilon\n"
+         "                          (2.2e-15); refused for the fixed-step members\n"
+         "  --step-control C        " + fixed + " (steps of H) or " + reversible +
+         " (symmetric Birkhoffian members: their own\n"
+         "                          steps for --position-tolerance, H is then the output step; docs/accuracy.md §4)\n"
+         "  --position-tolerance M  " + reversible + " step control: the position error [m] allowed at the horizon\n"
+         "  --duration T            simulated time after the start [s], > 0\n"
+         "  --output-rate HZ        output rows per simulated second [Hz], > 0\n"
+         "  --birkhoffian-form F    " + alternatives(birkhoff_cart::birkhoffian_form_names(), ", ", " or ") + "\n"
+         "  --quiet                 no progress lines on stderr\n"
+         "  --random-scene SEED:K   scene K of the seeded random family (a random valid cart, start, step,\n"
+         "                          duration and effects; docs/accuracy.md §3) instead of the file's, which\n"
+         "                          gives the rest (integrator, accuracy guard); the other options still apply\n"
+         "  --on-accuracy-error A   fail (default: exit 5 when the scene's accuracy guard reaches ERROR)\n"
+         "                          or warn (exit 0; the summary still names the quantity)\n"
+         "  --output FILE.csv       where to write t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,\n"
+         "                          local_error_estimate\n" +
+         integrator_table() +
+         "Every option also takes the form --option=value.\n"
+         "The rows are at t0 + k/HZ from the start to the end, both included; when the duration is not a\n"
+         "whole number of output intervals, a last row is written at the end time t0 + T itself (reached\n"
+         "by one shorter final step). Scene times are limited so that t + H stays exact to ~1e-6 H\n"
+         "(docs/scenes.md). Runs longer than a second report progress on stderr (once a second at most).\n"
+         "Exit status: 0 done; 2 bad arguments; 3 unusable scene, settings or output file;\n"
+         "4 a step failed or the run stopped (the rows written so far are kept); 5 the accuracy guard\n"
+         "reached ERROR (docs/accuracy.md; the summary on stdout names the quantity).\n";
+}
 
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -155,6 +195,15 @@ std::map<std::string, std::string> parse_arguments(int argc, char** argv) {
   return values;
 }
 
+/// `text` when it is one of `names`; else a UsageError naming the option, the choices and the
+/// closest one to a typo.
+std::string one_of(const std::string& option, const std::string& text, const std::vector<std::string>& names) {
+  if (std::find(names.begin(), names.end(), text) != names.end()) return text;
+  const std::string guess = birkhoff_cart::closest_name(text, names);
+  throw UsageError("option " + option + " must be " + alternatives(names, ", ", " or ", "'") + ", got '" + text + "'" +
+                   (guess.empty() ? "" : " (did you mean '" + guess + "'?)"));
+}
+
 /// Scene K of the random family SEED ("SEED:K", both whole numbers ≥ 0), on `base`.
 Scene random_scene(const std::string& text, const Scene& base) {
   const auto colon = text.find(':');
@@ -177,26 +226,21 @@ void apply_overrides(const std::map<std::string, std::string>& arguments, Scene&
     if (option == "--duration") scene.duration = parse_positive(option, text);
     if (option == "--output-rate") scene.output_rate = parse_positive(option, text);
     if (option == "--birkhoffian-form") {
-      if (text != "autonomous" && text != "paper") {
-        throw UsageError("option --birkhoffian-form must be 'autonomous' or 'paper', got '" + text + "'");
-      }
-      scene.integrator.birkhoffian_form = text;
+      scene.integrator.birkhoffian_form =
+          birkhoff_cart::parse_birkhoffian_form(one_of(option, text, birkhoff_cart::birkhoffian_form_names()));
     }
     if (option == "--step-control") {
-      if (text != "fixed" && text != "reversible") {
-        throw UsageError("option --step-control must be 'fixed' or 'reversible', got '" + text + "'");
-      }
-      scene.integrator.step_control = text;
+      scene.integrator.step_control =
+          birkhoff_cart::parse_step_control(one_of(option, text, birkhoff_cart::step_control_names()));
     }
     if (option == "--position-tolerance") scene.integrator.position_tolerance = parse_positive(option, text);
-    if (option == "--on-accuracy-error" && text != "fail" && text != "warn") {
-      throw UsageError("option --on-accuracy-error must be 'fail' or 'warn', got '" + text + "'");
-    }
+    if (option == "--on-accuracy-error") one_of(option, text, {"fail", "warn"});
   }
   // Each tolerance means one thing and is refused where it would be ignored.
   const birkhoff_cart::IntegratorSettings& settings = scene.integrator;
-  const bool reversible = settings.step_control == "reversible";
-  if (arguments.count("--tolerance") && settings.name != "dopri5") {
+  const bool reversible = settings.step_control == birkhoff_cart::StepControl::kReversible;
+  const birkhoff_cart::IntegratorEntry* member = birkhoff_cart::find_integrator(settings.name);
+  if (arguments.count("--tolerance") && !(member != nullptr && member->takes_tolerance())) {
     throw UsageError("option --tolerance is dopri5's local tolerance [-]; " + settings.name + " steps at " +
                      (reversible ? "the reversible step control's steps: give the position error [m] with "
                                    "--position-tolerance M"
@@ -286,7 +330,7 @@ bool close_output(std::FILE* file) {
 
 int run(int argc, char** argv) {
   if (asks_for_help(argc, argv)) {
-    std::fputs(kUsage, stdout);
+    std::fputs(usage().c_str(), stdout);
     return 0;
   }
   if (birkhoff_cart::print_version_if_asked(argc, argv, "cart_simulate")) return 0;
@@ -298,7 +342,7 @@ int run(int argc, char** argv) {
     if (arguments.count("--random-scene")) scene = random_scene(arguments.at("--random-scene"), scene);
     apply_overrides(arguments, scene);
   } catch (const UsageError& error) {
-    std::fprintf(stderr, "cart_simulate: %s\n%s", error.what(), kUsage);
+    std::fprintf(stderr, "cart_simulate: %s\n%s", error.what(), usage().c_str());
     return kExitUsage;
   } catch (const std::exception& error) {  // SceneError, or e.g. std::bad_alloc while reading
     std::fprintf(stderr, "cart_simulate: %s\n", error.what());

@@ -30,7 +30,7 @@ namespace {
 using namespace birkhoff_cart;
 
 struct Run {
-  std::string control;      ///< "fixed" or "reversible"
+  StepControl control = StepControl::kFixed;  ///< fixed steps of h, or the reversible controller's
   double setting = 0.0;     ///< h [s] or tolerance [m]
   double error = 0.0;       ///< final position error [m]
   double rhs = 0.0;         ///< rhs evaluations [-]
@@ -53,7 +53,7 @@ Scene whirl(const std::string& member, double duration) {
 Run run(const Scene& scene, double reference_x, double reference_y) {
   Run result;
   result.control = scene.integrator.step_control;
-  const bool fixed = result.control == "fixed";
+  const bool fixed = result.control == StepControl::kFixed;
   result.setting = fixed ? scene.integrator.step_size : scene.integrator.position_tolerance;
   Simulation simulation(scene);
   const double duration = scene.duration;
@@ -133,7 +133,7 @@ int main(int argc, char** argv) try {
   }
   for (double tolerance : {1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8}) {
     Scene scene = whirl(member, duration);
-    scene.integrator.step_control = "reversible";
+    scene.integrator.step_control = StepControl::kReversible;
     scene.integrator.position_tolerance = tolerance;
     scene.integrator.step_size = 1.0;  // the output step
     reversible.push_back(run(scene, rx, ry));
@@ -148,10 +148,10 @@ int main(int argc, char** argv) try {
                     "fixed_rhs_for_same_error\n");
   for (const std::vector<Run>* group : {&fixed, &reversible}) {
     for (const Run& r : *group) {
-      const double fixed_work = r.control == "fixed" ? std::nan("") : fixed_work_for(fixed, r.error);
-      std::printf("%-10s %9.3g %11.3e %10.4g %12.4g %8.2f %12.3e %12.3e %7.2f %14.3g\n", r.control.c_str(), r.setting,
+      const double fixed_work = r.control == StepControl::kFixed ? std::nan("") : fixed_work_for(fixed, r.error);
+      std::printf("%-10s %9.3g %11.3e %10.4g %12.4g %8.2f %12.3e %12.3e %7.2f %14.3g\n", to_string(r.control), r.setting,
                   r.error, r.steps, r.rhs, r.cpu, r.energy_first, r.energy_last, r.energy_last / r.energy_first, fixed_work / r.rhs);
-      std::fprintf(csv, "%s,%s,%.6g,%.6e,%.0f,%.0f,%.4f,%.6e,%.6e,%.6g\n", member.c_str(), r.control.c_str(), r.setting,
+      std::fprintf(csv, "%s,%s,%.6g,%.6e,%.0f,%.0f,%.4f,%.6e,%.6e,%.6g\n", member.c_str(), to_string(r.control), r.setting,
                    r.error, r.steps, r.rhs, r.cpu, r.energy_first, r.energy_last, fixed_work);
     }
   }

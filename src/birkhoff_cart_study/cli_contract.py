@@ -15,9 +15,10 @@ STEPS = [1e-4, 2e-4, 2.5e-4, 5e-4, 1e-3, 2e-3, 2.5e-3, 5e-3, 1e-2, 2e-2]  # h [s
 TIME_LINE = re.compile(r"^(  time:\s*)(\S+)(.*)$", re.M)
 
 
-def random_runs(seed, count, scene_names, integrators):
+def random_runs(seed, count, scene_names, integrators, adaptive, forms):
     """`count` random runs (seeded): each a dict with the scene's name, the start time t0 [s], the
-    duration T [s], the step h [s] and the other cart_simulate options."""
+    duration T [s], the step h [s] and the other cart_simulate options. `adaptive`: the integrators
+    that read a tolerance (each of their runs gets one); `forms`: the Birkhoffian forms."""
     rng = random.Random(seed)
     runs = []
     for _ in range(count):
@@ -40,10 +41,10 @@ def random_runs(seed, count, scene_names, integrators):
         else:
             run["output_rate"] = 10.0 ** rng.uniform(-1.0, 4.0)  # usually not: a refusal by name
         run["method"] = rng.choice(integrators)
-        if run["method"] == "dopri5" or rng.random() < 0.1:
+        if run["method"] in adaptive or rng.random() < 0.1:
             run["tolerance"] = 10.0 ** rng.uniform(-17.0, -4.0)
         if rng.random() < 0.2:
-            run["birkhoffian_form"] = rng.choice(["autonomous", "paper"])
+            run["birkhoffian_form"] = rng.choice(forms)
         runs.append(run)
     return runs
 

@@ -37,7 +37,6 @@ REFERENCE_KINDS = ("extended_precision", "dopri5", "analytic")
 ODEINT_PEERS = ("odeint_rk4", "odeint_dopri5", "odeint_rkf78", "odeint_bulirsch_stoer",
                 "odeint_bulirsch_stoer_dense_out")
 ODEINT_FIXED_STEP = ("odeint_rk4",)
-OUR_ADAPTIVE = ("dopri5",)
 
 TOP_KEYS = {"name", "description", "engine", "repetitions", "time_limit", "references", "experiments"}
 REFERENCE_KEYS = {"scene", "duration", "kind", "checkpoints"}
@@ -124,10 +123,10 @@ def _checkpoints(path, key, values, duration):
     return points
 
 
-def load_study(path, integrators, scene_dir):
+def load_study(path, registry, scene_dir):
     """Reads and validates the study at `path`; returns (study settings, list of task dicts).
 
-    `integrators` are the registry's names (from `cart_simulate --help`), `scene_dir` the shipped
+    `registry` is the integrator registry (registry.read_registry: `cart_simulate --help`), `scene_dir` the shipped
     scenes' directory. Nothing runs before the whole file has been checked."""
     try:
         with open(path) as f:
@@ -156,11 +155,11 @@ def load_study(path, integrators, scene_dir):
     if not isinstance(experiments, list) or not experiments:
         _fail(path, "experiments", "must be a non-empty list")
     if engine == "work_precision":
-        tasks = _measurement_tasks(path, doc, experiments, integrators, scene_dir, study)
+        tasks = _measurement_tasks(path, doc, experiments, registry, scene_dir, study)
     else:
         if "references" in doc:
             _fail(path, "references", "only for engine work_precision")
-        tasks = _cli_tasks(path, experiments, integrators, scene_dir, study)
+        tasks = _cli_tasks(path, experiments, registry, scene_dir, study)
     ids = set()
     for task in tasks:
         task["id"] = task_id(task)
@@ -170,7 +169,7 @@ def load_study(path, integrators, scene_dir):
     return study, tasks
 
 
-def _measurement_tasks(path, doc, experiments, integrators, scene_dir, study):
+def _measurement_tasks(path, doc, experiments, registry, scene_dir, study):
     references = doc.get("references", {})
     _check_keys(path, "references", references, set(references) if isinstance(references, dict) else set())
     reference_tasks = {}
@@ -193,7 +192,8 @@ def _measurement_tasks(path, doc, experiments, integrators, scene_dir, study):
             "scene": os.path.basename(scene_file), "scene_text": open(scene_file).read(),
             "duration": duration, "checkpoints": _checkpoints(path, where + ".checkpoints", ref.get("checkpoints"), duration),
             "time_limit": study["time_limit"]}
-    known_methods = [m for m in integrators] + list(ODEINT_PEERS)
+    known_methods = registry.names + list(ODEINT_PEERS)
+    our_adaptive = registry.adaptive
     tasks = []
     for reference in reference_tasks.values():
         if reference is not None:
@@ -236,7 +236,7 @@ def _measurement_tasks(path, doc, experiments, integrators, scene_dir, study):
             if method not in known_methods:
                 _fail(path, run_where, "unknown integrator (known: %s)" % ", ".join(known_methods))
             _check_keys(path, run_where, settings, RUN_KEYS)
-            fixed_step = method not in OUR_ADAPTIVE and method not in ODEINT_PEERS or method in ODEINT_FIXED_STEP
+            fixed_step = method not in our_adaptive and method not in ODEINT_PEERS or method in ODEINT_FIXED_STEP
             if fixed_step:
                 if "tolerances" in settings:
                     _fail(path, run_where + ".tolerances", "%s takes steps, not tolerances" % method)
@@ -251,7 +251,7 @@ def _measurement_tasks(path, doc, experiments, integrators, scene_dir, study):
                 values = [("tolerance", tol) for tol in _positive_list(path, run_where + ".tolerances", settings["tolerances"])]
             simulator_steps = [None]
             if "simulator_steps" in settings:
-                if method not in OUR_ADAPTIVE:
+                if method not in our_adaptive:
                     _fail(path, run_where + ".simulator_steps", "only for our dopri5")
                 simulator_steps = _positive_list(path, run_where + ".simulator_steps", settings["simulator_steps"])
             for simulator_step in simulator_steps:
@@ -274,7 +274,7 @@ def _whole(path, key, value, least):
     return value
 
 
-def _random_run_tasks(path, where, experiment, integrators, scene_dir, study):
+def _random_run_tasks(path, where, experiment, registry, scene_dir, study):
     """The seeded random runs of the CLI contract (cli_contract.random_runs): random scenes, start
     times, durations, steps, output rates, integrators, tolerances and forms."""
     allowed = {"label", "random_runs", "integrators"}
@@ -288,11 +288,11 @@ def _random_run_tasks(path, where, experiment, integrators, scene_dir, study):
     names = family.get("scenes") or sorted(f[:-5] for f in os.listdir(scene_dir) if f.endswith(".yaml"))
     files = {n: resolve_scene(path, where + ".random_runs.scenes", n, scene_dir)
              for n in _string_list(path, where + ".random_runs.scenes", names)}
-    methods = (_string_list(path, where + ".integrators", experiment["integrators"], integrators)
-               if "integrators" in experiment else list(integrators))
+    methods = (_string_list(path, where + ".integrators", experiment["integrators"], registry.names)
+               if "integrators" in experiment else registry.names)
     texts = {n: open(f).read() for n, f in files.items()}
     tasks = []
-    for index, run in enumerate(random_runs(seed, count, sorted(files), methods)):
+    for index, run in enumerate(random_runs(seed, count, sorted(files), methods, registry.adaptive, registry.forms)):
         text = with_start_time(texts[run["scene"]], run["start_time"])
         if text is None:
             _fail(path, where + ".random_runs.scenes", "scene %s has no initial_state time line" % run["scene"])
@@ -303,7 +303,7 @@ def _random_run_tasks(path, where, experiment, integrators, scene_dir, study):
     return tasks
 
 
-def _cli_tasks(path, experiments, integrators, scene_dir, study):
+def _cli_tasks(path, experiments, registry, scene_dir, study):
     tasks = []
     for i, experiment in enumerate(experiments):
         where = "experiments[%d]" % i
@@ -311,7 +311,7 @@ def _cli_tasks(path, experiments, integrators, scene_dir, study):
         if "random_runs" in experiment:
             if "label" not in experiment:
                 _fail(path, where + ".label", "required")
-            tasks += _random_run_tasks(path, where, experiment, integrators, scene_dir, study)
+            tasks += _random_run_tasks(path, where, experiment, registry, scene_dir, study)
             continue
         for key in ("label", "integrators"):
             if key not in experiment:
@@ -335,7 +335,7 @@ def _cli_tasks(path, experiments, integrators, scene_dir, study):
         else:
             scenes = [resolve_scene(path, "%s.scenes" % where, s, scene_dir)
                       for s in _string_list(path, where + ".scenes", experiment["scenes"])]
-        methods = _string_list(path, where + ".integrators", experiment["integrators"], integrators)
+        methods = _string_list(path, where + ".integrators", experiment["integrators"], registry.names)
         steps = _positive_list(path, where + ".steps", experiment["steps"]) if "steps" in experiment else [None]
         tolerances = (_positive_list(path, where + ".tolerances", experiment["tolerances"])
                       if "tolerances" in experiment else [None])
@@ -343,11 +343,11 @@ def _cli_tasks(path, experiments, integrators, scene_dir, study):
                      if "durations" in experiment else [None])
         rates = (_positive_list(path, where + ".output_rates", experiment["output_rates"])
                  if "output_rates" in experiment else [None])
-        forms = (_string_list(path, where + ".birkhoffian_forms", experiment["birkhoffian_forms"], ["autonomous", "paper"])
+        forms = (_string_list(path, where + ".birkhoffian_forms", experiment["birkhoffian_forms"], registry.forms)
                  if "birkhoffian_forms" in experiment else [None])
         control = experiment.get("step_control", "fixed")
-        if control not in ("fixed", "reversible"):
-            _fail(path, where + ".step_control", "must be fixed or reversible, got %r" % (control,))
+        if control not in registry.step_controls:
+            _fail(path, where + ".step_control", "must be %s, got %r" % (" or ".join(registry.step_controls), control))
         if control == "reversible" and tolerances == [None]:
             _fail(path, where + ".tolerances", "required with step_control: reversible")
         expect = experiment.get("expect", "finish")
@@ -359,7 +359,7 @@ def _cli_tasks(path, experiments, integrators, scene_dir, study):
         reference = experiment.get("reference")
         if reference is not None:
             _check_keys(path, where + ".reference", reference, CLI_REFERENCE_KEYS)
-            if reference.get("integrator") not in integrators:
+            if reference.get("integrator") not in registry.names:
                 _fail(path, where + ".reference.integrator", "unknown integrator %r" % (reference.get("integrator"),))
             reference_step = _positive(path, where + ".reference.step", reference.get("step"))
             if randoms != [None]:

@@ -33,4 +33,17 @@ std::string closest_name(const std::string& name, const std::vector<std::string>
   return best;
 }
 
+std::string name_list(const std::vector<std::string>& names) {
+  std::string list;
+  for (const std::string& name : names) list += (list.empty() ? "" : ", ") + name;
+  return list;
+}
+
+std::string unknown_name_message(const std::string& what, const std::string& name,
+                                 const std::vector<std::string>& known) {
+  const std::string guess = closest_name(name, known);
+  return "unknown " + what + " '" + name + "' (known: " + name_list(known) +
+         (guess.empty() ? "" : "; did you mean '" + guess + "'?") + ")";
+}
+
 }  // namespace birkhoff_cart

@@ -21,7 +21,7 @@ double paper_form_momentum_change_per_step(const Scene& scene) {
   const CartModel model{CartParameters{}};
   const EffectSet no_loads;
   IntegratorSettings settings = scene.integrator;
-  settings.step_control = "fixed";  // the chart's factor per step of h, whatever the run's control
+  settings.step_control = StepControl::kFixed;  // the chart's factor per step of h, whatever the run's control
   const std::unique_ptr<CartStepper> stepper = make_cart_stepper(settings, model, no_loads);
   CartState state;  // straight ahead at 1 m/s: p = M(0) ω is constant along the exact motion
   state.time = scene.initial_state.time;
@@ -40,7 +40,7 @@ double paper_form_momentum_growth(const Scene& scene, double duration) {
 }
 
 std::string paper_form_drift_warning(const Scene& scene) {
-  if (scene.integrator.birkhoffian_form != "paper") return "";
+  if (scene.integrator.birkhoffian_form != BirkhoffianForm::kPaper) return "";
   const double growth = paper_form_momentum_growth(scene, scene.duration);
   if (!(std::abs(growth) > kPaperFormDriftWarningThreshold)) return "";
   std::ostringstream message;

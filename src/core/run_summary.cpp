@@ -15,7 +15,7 @@ std::string local_error_estimate_summary(const StepStatistics& statistics, const
 }
 
 std::string step_control_summary(const IntegratorSettings& settings, const StepStatistics& statistics) {
-  if (settings.step_control != "reversible") return "";
+  if (settings.step_control != StepControl::kReversible) return "";
   char text[320];
   if (statistics.internal_steps == 0) {
     std::snprintf(text, sizeof text, "reversible step control: position tolerance %.3g m (no internal step yet)",
@@ -65,7 +65,7 @@ std::string run_summary(const Simulation& simulation, const AccuracyGuard& guard
   std::snprintf(line, sizeof line,
                 "summary: scene '%s', integrator %s, %s = %g s, t = %.9g s, %llu steps, %llu rhs evaluations\n",
                 simulation.scene().name.c_str(), simulation.integrator_name().c_str(),
-                simulation.scene().integrator.step_control == "reversible" ? "output step" : "h", simulation.step_size(),
+                simulation.scene().integrator.step_control == StepControl::kReversible ? "output step" : "h", simulation.step_size(),
                 simulation.state().time, static_cast<unsigned long long>(statistics.steps),
                 static_cast<unsigned long long>(statistics.rhs_evaluations));
   text += line;

@@ -8,8 +8,9 @@
 #include <stdexcept>
 
 #include "birkhoff_cart/core/cart_model.h"
+#include "birkhoff_cart/core/closest_name.h"
 #include "birkhoff_cart/core/effect_library.h"
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/integrators/integrator_registry.h"
 #include "birkhoff_cart/core/step_schedule.h"
 #include "scene_reader.h"
 
@@ -107,7 +108,8 @@ IntegratorSettings read_integrator(const SceneReader& reader, const YAML::Node& 
   settings.step_size = reader.required_number(node, key, "step_size", Range::kPositive);
   settings.tolerance = reader.optional_number(node, key, "tolerance", Range::kPositive, settings.tolerance);
   if (reader.has(node, "birkhoffian_form")) {
-    settings.birkhoffian_form = reader.choice(node, key, "birkhoffian_form", {"autonomous", "paper"});
+    settings.birkhoffian_form =
+        parse_birkhoffian_form(reader.choice(node, key, "birkhoffian_form", birkhoffian_form_names()));
   }
   settings.max_newton_iterations =
       reader.optional_positive_integer(node, key, "max_newton_iterations", settings.max_newton_iterations);
@@ -118,7 +120,7 @@ IntegratorSettings read_integrator(const SceneReader& reader, const YAML::Node& 
   settings.local_error_estimate =
       reader.optional_boolean(node, key, "local_error_estimate", settings.local_error_estimate);
   if (reader.has(node, "step_control")) {
-    settings.step_control = reader.choice(node, key, "step_control", {"fixed", "reversible"});
+    settings.step_control = parse_step_control(reader.choice(node, key, "step_control", step_control_names()));
   }
   settings.position_tolerance =
       reader.optional_number(node, key, "position_tolerance", Range::kPositive, settings.position_tolerance);
@@ -126,13 +128,11 @@ IntegratorSettings read_integrator(const SceneReader& reader, const YAML::Node& 
       reader.optional_number(node, key, "tolerance_horizon", Range::kPositive, settings.tolerance_horizon);
   // One meaning per key: `tolerance` is dopri5's local tolerance [-] (kept in the shipped scenes for a
   // switch to dopri5), `position_tolerance` the position error [m] the reversible step control aims at.
-  if (settings.step_control == "reversible") {
-    const std::vector<std::string> members = reversible_integrator_names();
-    if (std::find(members.begin(), members.end(), settings.name) == members.end()) {
-      std::string list;
-      for (const std::string& member : members) list += (list.empty() ? "" : ", ") + member;
-      reader.fail(key + ".step_control", "'reversible' is for the symmetric Birkhoffian members (" + list + "), not '" +
-                                             settings.name + "'");
+  if (settings.step_control == StepControl::kReversible) {
+    if (!integrator_entry(settings.name).reversible()) {
+      reader.fail(key + ".step_control", "'reversible' is for the symmetric Birkhoffian members (" +
+                                             name_list(reversible_integrator_names()) + "), not '" + settings.name +
+                                             "'");
     }
     if (!reader.has(node, "position_tolerance")) {
       reader.fail(key + ".position_tolerance", "is required with 'step_control: reversible': the position error [m] "
@@ -157,7 +157,7 @@ ReferenceSettings read_reference(const SceneReader& reader, const YAML::Node& no
   if (kind == "shadow_run") {
     reference.kind = ReferenceSettings::Kind::kShadowRun;
     reference.shadow = read_integrator(reader, reader.required(node, "reference", "integrator"), "reference.integrator");
-    if (reference.shadow.step_control != "fixed") {
+    if (reference.shadow.step_control != StepControl::kFixed) {
       reader.fail("reference.integrator.step_control", "must be 'fixed' (the shadow run is a dense dopri5 or a fixed step)");
     }
   } else {
@@ -204,7 +204,7 @@ Scene read_scene(const SceneReader& reader, const YAML::Node& root, const std::s
   scene.accuracy = scene_detail::read_accuracy(reader, root["accuracy"]);
   scene.odometry_sensor = scene_detail::read_odometry_sensor(reader, root["odometry_sensor"]);
   scene.actuators = scene_detail::read_actuators(reader, root);
-  if (scene.actuators.any() && scene.integrator.step_control == "reversible") {
+  if (scene.actuators.any() && scene.integrator.step_control == StepControl::kReversible) {
     reader.fail("integrator.step_control", "reversible cannot go with steering_actuator, drive_actuator or "
                                            "steering_end_stops (docs/actuators.md §4); use fixed");
   }

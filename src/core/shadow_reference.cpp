@@ -202,7 +202,7 @@ std::unique_ptr<ReferenceSolution> make_shadow_reference(const IntegratorSetting
               << kShadowToleranceFloor << " (100 machine epsilons): dopri5 cannot meet it in double precision";
       throw std::invalid_argument(message.str());
     }
-    if (shadow.birkhoffian_form == "autonomous") {
+    if (shadow.birkhoffian_form == BirkhoffianForm::kAutonomous) {
       return std::make_unique<DenseShadowReference>(shadow, initial, model, effects);
     }
   }

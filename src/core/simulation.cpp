@@ -40,7 +40,7 @@ void require_finite_torque(double torque, const char* which) {
 /// step being committed, while the actuators' state and the end-stop events advance step by step
 /// (docs/actuators.md §4).
 IntegratorSettings integrator_settings(const Scene& scene) {
-  if (scene.actuators.any() && scene.integrator.step_control == "reversible") {
+  if (scene.actuators.any() && scene.integrator.step_control == StepControl::kReversible) {
     throw std::invalid_argument(
         "integrator.step_control: reversible cannot go with steering_actuator, drive_actuator or steering_end_stops "
         "(docs/actuators.md); use fixed");

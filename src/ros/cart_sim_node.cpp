@@ -162,7 +162,7 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
 
   paused_ = parameters_.start_paused;
   restart_schedule();
-  const std::string step_control = simulation_->scene().integrator.step_control == "reversible"
+  const std::string step_control = simulation_->scene().integrator.step_control == StepControl::kReversible
                                        ? " (reversible step control for " +
                                              format_seconds(simulation_->scene().integrator.position_tolerance) +
                                              " m; h is the output step)"

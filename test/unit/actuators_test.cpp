@@ -301,7 +301,7 @@ TEST(EndStops, ABounceReversesTheRateByTheRestitution) {
 TEST(ActuatedCart, TheReversibleStepControlIsRefusedByName) {
   Scene scene = driven_scene();
   scene.integrator.name = "birkhoff_gauss4";
-  scene.integrator.step_control = "reversible";
+  scene.integrator.step_control = StepControl::kReversible;
   scene.integrator.position_tolerance = 1e-6;
   scene.actuators.steering = lag(0.1);
   try {

@@ -126,7 +126,7 @@ TEST(CartSimulate, CommandLineOverridesTheScene) {
   Scene scene = load_scene(scene_path("free_coast"));
   scene.integrator.name = "rk4";
   scene.integrator.step_size = 2e-3;
-  scene.integrator.birkhoffian_form = "paper";
+  scene.integrator.birkhoffian_form = BirkhoffianForm::kPaper;
   scene.output_rate = 50.0;
   scene.duration = 1.0;
   const std::vector<std::string> lines = read_lines(output);

@@ -20,20 +20,9 @@ namespace {
 
 using birkhoff_cart_test::cart_simulate_path;
 using birkhoff_cart_test::read_file;
+using birkhoff_cart_test::standard_output_of;
 
 const std::string kSourceDirectory = BIRKHOFF_CART_SOURCE_DIR;
-
-/// Everything a command writes to stdout.
-std::string standard_output_of(const std::string& command) {
-  std::string output;
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (pipe == nullptr) return output;
-  char buffer[4096];
-  std::size_t count = 0;
-  while ((count = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) output.append(buffer, count);
-  ::pclose(pipe);
-  return output;
-}
 
 /// The first fenced block (```) after `heading` in `markdown`, without its fences.
 std::string fenced_block_after(const std::string& markdown, const std::string& heading) {

@@ -213,7 +213,7 @@ TEST(PaperForm, EveryBirkhoffianMemberSupportsIt) {
                                  "birkhoff6_kahan_li", "birkhoff8_kahan_li"}) {
     CartState results[2];
     int index = 0;
-    for (const std::string form : {"autonomous", "paper"}) {
+    for (BirkhoffianForm form : {BirkhoffianForm::kAutonomous, BirkhoffianForm::kPaper}) {
       IntegratorSettings settings;
       settings.name = name;
       settings.birkhoffian_form = form;

@@ -86,19 +86,19 @@ bool all_finite(const CartState& state) {
 
 struct Method {
   std::string integrator;
-  std::string form;  ///< birkhoffian_form
+  BirkhoffianForm form;
 };
 
 std::vector<Method> every_method() {
   std::vector<Method> methods;
   for (const std::string& name : integrator_names()) {
-    for (const char* form : {"autonomous", "paper"}) methods.push_back({name, form});
+    for (BirkhoffianForm form : {BirkhoffianForm::kAutonomous, BirkhoffianForm::kPaper}) methods.push_back({name, form});
   }
   return methods;
 }
 
 std::string method_label(const ::testing::TestParamInfo<Method>& info) {
-  return info.param.integrator + "_" + info.param.form;
+  return info.param.integrator + "_" + to_string(info.param.form);
 }
 
 Scene with_method(Scene scene, const Method& method) {
@@ -189,7 +189,7 @@ TEST_P(PaperSingularity, StopsBeforeThePoleNamingTheSingularTime) {
   const double invariant = outcome.last.forward_speed * std::sin(outcome.last.steering_angle);  // ω1 sin χ = 1
   EXPECT_NEAR(invariant, 1.0, kPaperInvariantTolerance);
   std::printf("[ measured ] paper pole %s/%s: stopped at t = %.9f s, omega1 = %.6g m/s, |omega1 sin chi - 1| = %.3g\n",
-              GetParam().integrator.c_str(), GetParam().form.c_str(), outcome.last.time, outcome.last.forward_speed,
+              GetParam().integrator.c_str(), to_string(GetParam().form), outcome.last.time, outcome.last.forward_speed,
               std::abs(invariant - 1.0));
 }
 
@@ -258,7 +258,7 @@ std::vector<FreeCase> free_cases(const std::vector<std::string>& scenes) {
 }
 
 std::string free_label(const ::testing::TestParamInfo<FreeCase>& info) {
-  return info.param.scene + "_" + info.param.method.integrator + "_" + info.param.method.form;
+  return info.param.scene + "_" + info.param.method.integrator + "_" + to_string(info.param.method.form);
 }
 
 void expect_free_invariants(const RunOutcome& outcome, const std::string& label) {
@@ -283,7 +283,7 @@ TEST_P(Jackknife, ThroughQuarterAndWholeTurnsWithInvariantsKept) {
   const bool whirl = c.scene == "jackknife_whirl";
   if (whirl) scene.duration = kWhirlDuration;
   const RunOutcome outcome = run(scene);
-  const std::string label = c.scene + "/" + c.method.integrator + "/" + c.method.form;
+  const std::string label = c.scene + "/" + c.method.integrator + "/" + to_string(c.method.form);
   expect_free_invariants(outcome, label);
   if (whirl) {
     // χ passes the jackknife angle π/2 (cos χ = 0) and goes on through whole turns, unwrapped.
@@ -305,7 +305,7 @@ TEST_P(ReverseDriving, InvariantsKeptWhileTheStateDiverges) {
   const Scene scene = with_method(shipped(c.scene), c.method);
   Scene perturbed = scene;
   perturbed.initial_state.steering_rate += kReversePerturbation;
-  const std::string label = c.scene + "/" + c.method.integrator + "/" + c.method.form;
+  const std::string label = c.scene + "/" + c.method.integrator + "/" + to_string(c.method.form);
   // Both runs side by side: the largest separation of their steering angles over the run.
   Simulation nominal(scene);
   Simulation neighbour(perturbed);
@@ -419,7 +419,7 @@ Scene step_torque_scene() {
 /// h = 0.2 s stops (Newton meets a singular Jacobian at t ≈ 2.27 s: its inner substep γ₂h = −0.34 s
 /// runs backwards through the step torque); every other member, new ones included, runs to the end.
 bool large_step_run_stops(const Method& method, double h) {
-  return method.integrator == "birkhoff4" && method.form == "paper" && h == 0.2;
+  return method.integrator == "birkhoff4" && method.form == BirkhoffianForm::kPaper && h == 0.2;
 }
 
 TEST(LargeSteps, BoundedOrAClearErrorNeverGarbage) {
@@ -435,7 +435,7 @@ TEST(LargeSteps, BoundedOrAClearErrorNeverGarbage) {
       Scene scene = with_method(step_torque_scene(), method);
       scene.integrator.step_size = h;
       const RunOutcome outcome = run(scene);
-      const std::string label = method.integrator + "/" + method.form + " h = " + std::to_string(h);
+      const std::string label = method.integrator + "/" + to_string(method.form) + " h = " + std::to_string(h);
       EXPECT_TRUE(outcome.every_state_finite) << label;
       // Pinned outcome: every run reaches the end except those listed as stopping.
       EXPECT_EQ(outcome.stopped, large_step_run_stops(method, h)) << label << ": " << outcome.error;

@@ -45,7 +45,7 @@ struct HourOutcome {
   double seconds = 0.0;                  ///< wall time [s]
 };
 
-HourOutcome run_one_hour(const std::string& form) {
+HourOutcome run_one_hour(BirkhoffianForm form) {
   Scene scene = load_scene(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/default.yaml");
   scene.reference.kind = ReferenceSettings::Kind::kNone;  // no dopri5 shadow for an hour
   scene.integrator.name = "birkhoff2";
@@ -73,7 +73,7 @@ HourOutcome run_one_hour(const std::string& form) {
   outcome.last = simulation.state();
   std::printf("[ measured ] one hour, birkhoff2 %s form: %.1f s wall, t = %.3f s, omega1 = %.6f m/s, T* - T*0 - W max "
               "%.3g J, p2 balance max %.3g kg m^2/s, constraints %.3g m/s, pi1 = %.1f m\n",
-              form.c_str(), outcome.seconds, outcome.last.time, outcome.last.forward_speed, outcome.max_energy_balance,
+              to_string(form), outcome.seconds, outcome.last.time, outcome.last.forward_speed, outcome.max_energy_balance,
               outcome.max_p2_balance, outcome.max_constraint, outcome.last.arc_length);
   return outcome;
 }
@@ -91,10 +91,10 @@ TEST(LongHorizon, TheStructureFactorWouldOverflowWithoutTheEpoch) {
 }
 
 TEST(LongHorizon, OneDrivenHourInBothRepresentationsKeepsItsBalances) {
-  const HourOutcome autonomous = run_one_hour("autonomous");
-  const HourOutcome paper = run_one_hour("paper");
+  const HourOutcome autonomous = run_one_hour(BirkhoffianForm::kAutonomous);
+  const HourOutcome paper = run_one_hour(BirkhoffianForm::kPaper);
   for (const HourOutcome* outcome : {&autonomous, &paper}) {
-    const char* form = outcome == &autonomous ? "autonomous" : "paper";
+    const char* form = to_string(outcome == &autonomous ? BirkhoffianForm::kAutonomous : BirkhoffianForm::kPaper);
     ASSERT_TRUE(outcome->finite) << form << " stopped being finite at t = " << outcome->last.time;
     EXPECT_EQ(outcome->last.time, kOneHour) << form;  // t₀ + n h exactly
     EXPECT_LT(outcome->max_energy_balance,

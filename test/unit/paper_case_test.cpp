@@ -33,7 +33,7 @@ struct PaperErrors {
 };
 
 /// Whole steps of h from t₀ and one final partial step that lands on kEndTime exactly.
-PaperErrors run(const std::string& integrator, const std::string& form, double h) {
+PaperErrors run(const std::string& integrator, BirkhoffianForm form, double h) {
   const Scene scene = load_scene(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/paper_special.yaml");
   const CartModel model(scene.cart, InertiaModel::kPaperSpecialCase);
   const EffectSet effects;
@@ -63,7 +63,7 @@ PaperErrors run(const std::string& integrator, const std::string& form, double h
 
 struct Case {
   std::string integrator;
-  std::string form;
+  BirkhoffianForm form;
 };
 
 class PaperCase : public ::testing::TestWithParam<Case> {};
@@ -74,14 +74,14 @@ TEST_P(PaperCase, SecondOrderErrorAgainstTheAnalyticSolution) {
   const PaperErrors nominal = run(c.integrator, c.form, 1e-3);
   const PaperErrors fine = run(c.integrator, c.form, 5e-4);
   std::printf("%s (%s) at t = pi - 0.05: h = 1e-3: pi1 relative error %.3e, omega1 relative error %.3e\n",
-              c.integrator.c_str(), c.form.c_str(), nominal.arc_length, nominal.forward_speed);
+              c.integrator.c_str(), to_string(c.form), nominal.arc_length, nominal.forward_speed);
   const double pi1_orders[2] = {std::log2(coarse.arc_length / nominal.arc_length),
                                 std::log2(nominal.arc_length / fine.arc_length)};
   const double omega1_orders[2] = {std::log2(coarse.forward_speed / nominal.forward_speed),
                                    std::log2(nominal.forward_speed / fine.forward_speed)};
   std::printf("%s (%s): pi1 errors %.3e %.3e %.3e (orders %.3f %.3f); omega1 errors %.3e %.3e %.3e "
               "(orders %.3f %.3f)\n",
-              c.integrator.c_str(), c.form.c_str(), coarse.arc_length, nominal.arc_length, fine.arc_length,
+              c.integrator.c_str(), to_string(c.form), coarse.arc_length, nominal.arc_length, fine.arc_length,
               pi1_orders[0], pi1_orders[1], coarse.forward_speed, nominal.forward_speed, fine.forward_speed,
               omega1_orders[0], omega1_orders[1]);
   for (int i = 0; i < 2; ++i) {
@@ -97,10 +97,11 @@ TEST_P(PaperCase, SecondOrderErrorAgainstTheAnalyticSolution) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Paper, PaperCase,
-                         ::testing::Values(Case{"birkhoff2", "paper"}, Case{"birkhoff2", "autonomous"},
-                                           Case{"rk2", "paper"}),
+                         ::testing::Values(Case{"birkhoff2", BirkhoffianForm::kPaper},
+                                           Case{"birkhoff2", BirkhoffianForm::kAutonomous},
+                                           Case{"rk2", BirkhoffianForm::kPaper}),
                          [](const ::testing::TestParamInfo<Case>& info) {
-                           return info.param.integrator + "_" + info.param.form;
+                           return info.param.integrator + "_" + to_string(info.param.form);
                          });
 
 }  // namespace

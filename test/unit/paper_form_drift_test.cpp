@@ -20,7 +20,7 @@ constexpr double kRoundOffDelta = 1e-14;       // |δ| of a member that does not
 constexpr double kClosedFormAgreement = 1e-6;  // relative, δ(birkhoff2) vs (1 + h/2)/(1 − h/2)·e^{−h} − 1 [-]
 constexpr double kPredictionAgreement = 0.1;   // relative, predicted vs measured energy growth [-]
 
-Scene scene(const std::string& integrator, const std::string& form, double step, double duration) {
+Scene scene(const std::string& integrator, BirkhoffianForm form, double step, double duration) {
   Scene s = load_scene(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/free_coast.yaml");
   s.integrator.name = integrator;
   s.integrator.birkhoffian_form = form;
@@ -31,7 +31,7 @@ Scene scene(const std::string& integrator, const std::string& form, double step,
 
 TEST(PaperFormDrift, Birkhoff2StepMultipliesMomentaByTheClosedFormFactor) {
   for (double h : {0.01, 0.05, 0.1}) {
-    const double delta = paper_form_momentum_change_per_step(scene("birkhoff2", "paper", h, 1.0));
+    const double delta = paper_form_momentum_change_per_step(scene("birkhoff2", BirkhoffianForm::kPaper, h, 1.0));
     const double closed_form = (1.0 + h / 2) / (1.0 - h / 2) * std::exp(-h) - 1.0;  // = h³/12 + O(h⁵)
     std::printf("[ measured ] birkhoff2 paper form h = %g: δ = %.6e per step (closed form %.6e, h³/12 = %.6e)\n", h,
                 delta, closed_form, h * h * h / 12);
@@ -41,16 +41,18 @@ TEST(PaperFormDrift, Birkhoff2StepMultipliesMomentaByTheClosedFormFactor) {
 
 TEST(PaperFormDrift, AutonomousFormAndChartFreeMembersDoNotDrift) {
   for (const std::string& name : integrator_names()) {
-    const double autonomous = paper_form_momentum_change_per_step(scene(name, "autonomous", 0.05, 1.0));
+    const double autonomous =
+        paper_form_momentum_change_per_step(scene(name, BirkhoffianForm::kAutonomous, 0.05, 1.0));
     EXPECT_LE(std::abs(autonomous), kRoundOffDelta) << name;
-    EXPECT_EQ(paper_form_drift_warning(scene(name, "autonomous", 0.05, 1e5)), "") << name;
+    EXPECT_EQ(paper_form_drift_warning(scene(name, BirkhoffianForm::kAutonomous, 0.05, 1e5)), "") << name;
   }
   for (const char* name : {"midpoint", "rk4"}) {  // they integrate ż itself: the chart never enters
-    EXPECT_LE(std::abs(paper_form_momentum_change_per_step(scene(name, "paper", 0.05, 1.0))), kRoundOffDelta) << name;
+    const double paper = paper_form_momentum_change_per_step(scene(name, BirkhoffianForm::kPaper, 0.05, 1.0));
+    EXPECT_LE(std::abs(paper), kRoundOffDelta) << name;
   }
   // birkhoff4's triple jump has Σγᵢ³ = 0: the h³ terms of its three substeps cancel, δ = O(h⁵).
-  const double birkhoff4 = paper_form_momentum_change_per_step(scene("birkhoff4", "paper", 0.05, 1.0));
-  const double birkhoff2 = paper_form_momentum_change_per_step(scene("birkhoff2", "paper", 0.05, 1.0));
+  const double birkhoff4 = paper_form_momentum_change_per_step(scene("birkhoff4", BirkhoffianForm::kPaper, 0.05, 1.0));
+  const double birkhoff2 = paper_form_momentum_change_per_step(scene("birkhoff2", BirkhoffianForm::kPaper, 0.05, 1.0));
   std::printf("[ measured ] paper form h = 0.05: δ(birkhoff2) = %.3e, δ(birkhoff4) = %.3e per step\n", birkhoff2,
               birkhoff4);
   EXPECT_LT(std::abs(birkhoff4), 1e-2 * birkhoff2);
@@ -60,11 +62,11 @@ TEST(PaperFormDrift, PredictedGrowthIsWhatARunShowsAndTheWarningFiresOnlyWhenItM
   // The free whirl in the paper form with birkhoff2 at h = 0.05 s over 100 s: the energy, ∝ p²,
   // grows by (1 + g)² − 1 with g the predicted momentum growth; the autonomous run stays put.
   constexpr double kStep = 0.05, kDuration = 100.0;  // [s]
-  const Scene paper = scene("birkhoff2", "paper", kStep, kDuration);
+  const Scene paper = scene("birkhoff2", BirkhoffianForm::kPaper, kStep, kDuration);
   const double growth = paper_form_momentum_growth(paper, kDuration);
   const double predicted_energy_growth = (1.0 + growth) * (1.0 + growth) - 1.0;
   Simulation drifting(paper);
-  Simulation steady(scene("birkhoff2", "autonomous", kStep, kDuration));
+  Simulation steady(scene("birkhoff2", BirkhoffianForm::kAutonomous, kStep, kDuration));
   const double energy0 = drifting.diagnostics().energy;
   drifting.advance_to(drifting.end_time());
   steady.advance_to(steady.end_time());
@@ -78,8 +80,8 @@ TEST(PaperFormDrift, PredictedGrowthIsWhatARunShowsAndTheWarningFiresOnlyWhenItM
   const std::string warning = paper_form_drift_warning(paper);
   EXPECT_NE(warning.find("birkhoff2"), std::string::npos) << warning;
   EXPECT_NE(warning.find("autonomous"), std::string::npos) << warning;
-  EXPECT_EQ(paper_form_drift_warning(scene("birkhoff2", "paper", kStep, 1.0)), "");
-  EXPECT_EQ(paper_form_drift_warning(scene("midpoint", "paper", kStep, 1e4)), "");
+  EXPECT_EQ(paper_form_drift_warning(scene("birkhoff2", BirkhoffianForm::kPaper, kStep, 1.0)), "");
+  EXPECT_EQ(paper_form_drift_warning(scene("midpoint", BirkhoffianForm::kPaper, kStep, 1e4)), "");
 }
 
 }  // namespace

@@ -95,7 +95,7 @@ TEST(RandomHardCases, EveryIntegratorEndsFiniteWithAVerdictOrStopsWithANamedStep
       Scene run = scene;
       run.integrator.name = integrator.substr(0, integrator.find(' '));
       if (reversible) {  // "NAME reversible TOL"
-        run.integrator.step_control = "reversible";
+        run.integrator.step_control = StepControl::kReversible;
         run.integrator.position_tolerance = std::stod(integrator.substr(integrator.rfind(' ') + 1));
       }
       std::unique_ptr<Simulation> built;

@@ -1,10 +1,12 @@
 // What each registered integrator's step map preserves for the real cart (Λ ≠ 0), measured
 // through the registry (make_cart_stepper) for every name in integrator_names() and both
 // Birkhoffian forms, so a new member is covered without touching this file:
-//  (its reported order() is checked against the order observed by step halving along the
-//  independent model's path in trajectory_vs_independent_model_test.cpp);
-//  - its reported symmetric() is what the free cart shows under the two reversing maps of the
-//    cart (Modin & Verdier 2020): R₁: p ↦ −p, and R₂: (π1, χ) ↦ (−π1, −π − χ) with p kept.
+//  (its order, as the table and the built stepper state it, is checked against the order observed
+//  by step halving in integrator_registry_test.cpp and along the independent model's path in
+//  trajectory_vs_independent_model_test.cpp);
+//  - its symmetry, as the table and the built stepper state it, is what the free cart shows under
+//    the two reversing maps of the cart (Modin & Verdier 2020): R₁: p ↦ −p, and
+//    R₂: (π1, χ) ↦ (−π1, −π − χ) with p kept.
 //    A symmetric member's step map Φ_h is R-reversible, R Φ_h R Φ_h = id, to round-off in the
 //    autonomous form; a non-symmetric one misses by O(n h^{p+1});
 //  - in the paper's eᵗ form a member that steps in the chart w = (π1, χ, e^{t−tₑ} p) is not
@@ -24,6 +26,7 @@
 #include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/effect_library.h"
 #include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/integrators/integrator_registry.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
 
@@ -44,7 +47,7 @@ Scene load(const std::string& name) {
 /// The registry's settings for `name` in `form`. The dopri5 tolerance is set so large that its
 /// controller accepts every full step: its map is then the fixed-step 5th-order Dormand–Prince map,
 /// whose irreversibility shows at h = 0.1 s (at 1e-10 it would be at its tolerance).
-IntegratorSettings settings_for(const std::string& name, const std::string& form) {
+IntegratorSettings settings_for(const std::string& name, BirkhoffianForm form) {
   IntegratorSettings settings;
   settings.name = name;
   settings.birkhoffian_form = form;
@@ -120,15 +123,16 @@ std::vector<std::string> names() { return integrator_names(); }
 
 class RegistryMember : public testing::TestWithParam<std::string> {
  protected:
-  std::unique_ptr<CartStepper> make(const std::string& form, const Runner& runner) const {
+  std::unique_ptr<CartStepper> make(BirkhoffianForm form, const Runner& runner) const {
     return make_cart_stepper(settings_for(GetParam(), form), runner.model, runner.effects);
   }
 };
 
 TEST_P(RegistryMember, ReportedSymmetryIsReversibilityUnderBothMapsInTheAutonomousForm) {
   const Runner runner(load("free_coast"));
-  const IntegratorSettings settings = settings_for(GetParam(), "autonomous");
-  const bool symmetric = make("autonomous", runner)->symmetric();
+  const IntegratorSettings settings = settings_for(GetParam(), BirkhoffianForm::kAutonomous);
+  const bool symmetric = integrator_entry(GetParam()).symmetric;  // the table's claim
+  EXPECT_EQ(make(BirkhoffianForm::kAutonomous, runner)->symmetric(), symmetric);
   const double flip = reversal_defect(runner, settings, momentum_flip);
   const double reflection = reversal_defect(runner, settings, steering_reflection);
   std::printf("[ measured ] %s (autonomous, %s): reversal defect %.3e under p ↦ −p, %.3e under (π1, χ) ↦ (−π1, −π − χ)\n",
@@ -144,8 +148,8 @@ TEST_P(RegistryMember, ReportedSymmetryIsReversibilityUnderBothMapsInTheAutonomo
 
 TEST_P(RegistryMember, PaperFormIsReversibleOnlyWhereItMakesTheAutonomousSteps) {
   const Runner runner(load("free_coast"));
-  const IntegratorSettings autonomous = settings_for(GetParam(), "autonomous");
-  const IntegratorSettings paper = settings_for(GetParam(), "paper");
+  const IntegratorSettings autonomous = settings_for(GetParam(), BirkhoffianForm::kAutonomous);
+  const IntegratorSettings paper = settings_for(GetParam(), BirkhoffianForm::kPaper);
   CartState start = runner.scene.initial_state;
   start.time = 3.0;
   const CartState by_autonomous = runner.run(autonomous, start, kReversalStep, kReversalSteps);
@@ -176,7 +180,7 @@ struct SteeringMomentumRun {
   std::vector<double> p2;     ///< p2 after each step [kg·m²/s]
 };
 
-SteeringMomentumRun steering_momentum_run(const std::string& name, const std::string& form) {
+SteeringMomentumRun steering_momentum_run(const std::string& name, BirkhoffianForm form) {
   Scene scene = load("sine_steer_torque");
   EffectSpec damping;
   damping.name = "steering_damping";
@@ -201,8 +205,8 @@ SteeringMomentumRun steering_momentum_run(const std::string& name, const std::st
 // it to round-off in the autonomous form. In the paper form a member that steps in the chart
 // (e^{t−tₑ} p2) does not: its p2 departs from the autonomous run's and the balance shows it.
 TEST_P(RegistryMember, SteeringMomentumBalanceIsExactInTheAutonomousForm) {
-  const SteeringMomentumRun autonomous = steering_momentum_run(GetParam(), "autonomous");
-  const SteeringMomentumRun paper = steering_momentum_run(GetParam(), "paper");
+  const SteeringMomentumRun autonomous = steering_momentum_run(GetParam(), BirkhoffianForm::kAutonomous);
+  const SteeringMomentumRun paper = steering_momentum_run(GetParam(), BirkhoffianForm::kPaper);
   double departure = 0.0;  // max |p2(paper) − p2(autonomous)| / max(1, |p2|) [-]
   for (std::size_t k = 0; k < paper.p2.size(); ++k) {
     departure = std::max(departure, std::abs(paper.p2[k] - autonomous.p2[k]) / std::max(1.0, std::abs(autonomous.p2[k])));

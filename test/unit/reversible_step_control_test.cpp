@@ -154,7 +154,7 @@ TEST(ReversibleStepControl, StepsFollowTheStepDensity) {
 Scene reversible_whirl(const std::string& member, double tolerance, double duration, double output_step) {
   Scene scene = whirl();
   scene.integrator.name = member;
-  scene.integrator.step_control = "reversible";
+  scene.integrator.step_control = StepControl::kReversible;
   scene.integrator.position_tolerance = tolerance;
   scene.duration = duration;
   scene.integrator.step_size = output_step;
@@ -256,7 +256,7 @@ TEST(ReversibleStepControl, ErrorConvergesWithTheMembersOrderInEpsilon) {
 TEST(ReversibleStepControl, BadSettingsAreRefusedByName) {
   Scene scene = whirl();
   scene.integrator.name = "rk4";
-  scene.integrator.step_control = "reversible";
+  scene.integrator.step_control = StepControl::kReversible;
   try {
     Simulation simulation(scene);
     FAIL() << "rk4 under reversible control was accepted";

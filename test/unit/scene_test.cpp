@@ -202,7 +202,7 @@ TEST(ShippedScenes, PaperSpecialCase) {
   EXPECT_EQ(paper.reference.kind, ReferenceSettings::Kind::kPaperAnalytic);
   EXPECT_EQ(paper.integrator.name, "birkhoff2");
   EXPECT_EQ(paper.integrator.step_size, 1e-3);
-  EXPECT_EQ(paper.integrator.birkhoffian_form, "paper");
+  EXPECT_EQ(paper.integrator.birkhoffian_form, BirkhoffianForm::kPaper);
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -249,7 +249,7 @@ TEST_F(SceneFiles, MinimalSceneGetsTheDocumentedDefaults) {
   EXPECT_EQ(scene.initial_state.steering_angle, 0.1);
   EXPECT_EQ(scene.integrator.name, "rk4");
   EXPECT_EQ(scene.integrator.tolerance, 1e-10);
-  EXPECT_EQ(scene.integrator.birkhoffian_form, "autonomous");
+  EXPECT_EQ(scene.integrator.birkhoffian_form, BirkhoffianForm::kAutonomous);
   EXPECT_EQ(scene.integrator.max_newton_iterations, 30);
   EXPECT_EQ(scene.integrator.newton_tolerance, 1e-14);
   EXPECT_TRUE(scene.integrator.compensated_summation);

@@ -87,6 +87,18 @@ inline std::string directory_of_this_binary() {
 /// The batch CLI, built next to the unit tests.
 inline std::string cart_simulate_path() { return directory_of_this_binary() + "/cart_simulate"; }
 
+/// Everything `command` (run through the shell) writes to stdout.
+inline std::string standard_output_of(const std::string& command) {
+  std::string output;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (pipe == nullptr) return output;
+  char buffer[4096];
+  std::size_t count = 0;
+  while ((count = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) output.append(buffer, count);
+  ::pclose(pipe);
+  return output;
+}
+
 /// What a cart_simulate run left: its exit status (−1 when it died of a signal) and its stderr.
 struct CliOutcome {
   int exit_status = -1;

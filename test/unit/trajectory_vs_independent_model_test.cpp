@@ -82,7 +82,7 @@ CartState start_state() {
   return state;
 }
 
-Scene driven_scene(const std::string& integrator, const std::string& form, double step) {
+Scene driven_scene(const std::string& integrator, BirkhoffianForm form, double step) {
   Scene scene;
   scene.name = "trajectory_vs_independent_model";
   scene.initial_state = start_state();
@@ -166,19 +166,19 @@ const std::vector<Observables>& independent_path() {
 
 struct Member {
   std::string integrator;
-  std::string form;
+  BirkhoffianForm form;
 };
 
 std::vector<Member> all_members() {
   std::vector<Member> members;
   for (const std::string& name : integrator_names()) {
-    for (const char* form : {"autonomous", "paper"}) members.push_back({name, form});
+    for (BirkhoffianForm form : {BirkhoffianForm::kAutonomous, BirkhoffianForm::kPaper}) members.push_back({name, form});
   }
   return members;
 }
 
 std::string member_label(const testing::TestParamInfo<Member>& info) {
-  return info.param.integrator + "_" + info.param.form;
+  return info.param.integrator + "_" + to_string(info.param.form);
 }
 
 /// The largest difference between the simulator's path and the independent model's.
@@ -228,14 +228,14 @@ TEST_P(TrajectoryAgainstIndependentModel, AgreesWithinTheMembersOrderBound) {
   const PathError at_h = path_error(member, h);
   const PathError at_half = path_error(member, h / 2);
   const double observed_order = std::log2(at_h.worst / at_half.worst);
-  std::cout << "[ measured ] " << member.integrator << " (" << member.form << ", order " << order << ", h = " << h
+  std::cout << "[ measured ] " << member.integrator << " (" << to_string(member.form) << ", order " << order << ", h = " << h
             << " s): max |simulator − independent| = " << at_h.worst << " (component " << at_h.component
             << " at t = " << at_h.time << " s), error/h^p = " << at_h.worst / std::pow(h, order) << ", bound " << bound
             << "; at h/2: " << at_half.worst << ", observed order " << observed_order << "\n";
-  EXPECT_LT(at_h.worst, bound) << member.integrator << " (" << member.form << ")";
+  EXPECT_LT(at_h.worst, bound) << member.integrator << " (" << to_string(member.form) << ")";
   EXPECT_LT(at_half.worst, kErrorConstant * std::pow(h / 2, order) + kRoundOffFloor);
   if (at_half.worst > kOrderCheckFloor) {
-    EXPECT_NEAR(observed_order, order, kOrderSlack) << member.integrator << " (" << member.form << ")";
+    EXPECT_NEAR(observed_order, order, kOrderSlack) << member.integrator << " (" << to_string(member.form) << ")";
   }
   // The run really exercises the loads: the drive sped the cart up and the steering swung.
   EXPECT_GT(at_h.final_forward_speed, 2.0 * start_state().forward_speed);

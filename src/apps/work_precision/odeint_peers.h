@@ -217,7 +217,7 @@ RunRecord measure_odeint_typed(const BenchScene& bench, const std::string& metho
 
 inline RunRecord measure_odeint(const BenchScene& bench, const std::string& method, double step, double tolerance,
                                 int repetitions) {
-  if (bench.scene.integrator.birkhoffian_form == "paper") {
+  if (bench.scene.integrator.birkhoffian_form == BirkhoffianForm::kPaper) {
     return measure_odeint_typed<CartPaperBirkhoffian>(bench, method, step, tolerance, repetitions);
   }
   return measure_odeint_typed<CartAutonomousBirkhoffian>(bench, method, step, tolerance, repetitions);

@@ -40,9 +40,9 @@ inline ReferenceRun extended_precision_run(const BenchScene& bench, const std::s
   namespace odeint = boost::numeric::odeint;
   using S = long double;
   using Joint = JointState<S>;
-  if (bench.scene.integrator.birkhoffian_form != "autonomous") {
-    throw std::invalid_argument("extended-precision reference: autonomous form only, got '" +
-                                bench.scene.integrator.birkhoffian_form + "'");
+  if (bench.scene.integrator.birkhoffian_form != BirkhoffianForm::kAutonomous) {
+    throw std::invalid_argument(std::string("extended-precision reference: autonomous form only, got '") +
+                                to_string(bench.scene.integrator.birkhoffian_form) + "'");
   }
   const Simulation holder(configured(bench.scene, "rk4", 0.1, 1e-10));
   const CartAutonomousBirkhoffian system(holder.model(), holder.effects());

@@ -1,7 +1,7 @@
 // The CartStepper of a symmetric Birkhoffian member under reversible step control
 // (reversible_step_control.h; docs/birkhoffian.md §11): the caller's step h is the output step, the
 // member's own grid is chosen by the controller, and the state at each output instant comes from a
-// side step off the grid. Private to the core library (cart_stepper.cpp makes it).
+// side step off the grid. Private to the core library (integrator_registry.cpp makes it).
 //
 // Tolerance → ε (§11.3, eq. (B.45)). The global position error of a run with fixed ε behaves like
 // C·ε^p·(t − t₀) (symmetric member of order p; the error of a whirl grows like its phase error,

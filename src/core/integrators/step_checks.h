@@ -1,4 +1,4 @@
-// The checks every CartStepper adapter makes (cart_stepper.cpp, reversible_cart_stepper.h): a
+// The checks every CartStepper adapter makes (cart_stepper_adapter.h, reversible_cart_stepper.h): a
 // valid step size in, finite coordinates and quasi-velocities out, with errors that name the
 // coordinate. Private to the core library.
 #pragma once

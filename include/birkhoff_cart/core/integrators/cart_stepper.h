@@ -1,4 +1,5 @@
-// The type-erased integrator the simulation uses, and the registry that makes one by name.
+// The type-erased integrator the simulation uses, and make_cart_stepper, which builds a member of
+// the registry (integrator_registry.h) by name.
 #pragma once
 
 #include <memory>
@@ -10,6 +11,7 @@
 #include "birkhoff_cart/core/diagnostics.h"
 #include "birkhoff_cart/core/effects.h"
 #include "birkhoff_cart/core/integrator_settings.h"
+#include "birkhoff_cart/core/integrators/integrator_registry.h"
 #include "birkhoff_cart/core/state.h"
 
 namespace birkhoff_cart {
@@ -39,15 +41,10 @@ class CartStepper {
   virtual void prepare(const CartState& /*start*/, StepStatistics& /*statistics*/) {}
 };
 
-/// Registered names: birkhoff2, birkhoff4, rk2, rk4, dopri5, midpoint, birkhoff_gauss4, birkhoff_gauss6,
-/// birkhoff_gauss8, birkhoff4_suzuki, birkhoff6_kahan_li, birkhoff8_kahan_li.
-std::vector<std::string> integrator_names();
-
-/// The members that take step_control "reversible" (the symmetric Birkhoffian ones).
-std::vector<std::string> reversible_integrator_names();
-
-/// Makes the named integrator for `model` and `effects` (both must outlive it). Throws
-/// std::invalid_argument for an unknown name (listing the known ones) or bad settings.
+/// Makes the registry's member settings.name (integrator_registry.h) for `model` and `effects`
+/// (both must outlive it), at fixed steps or under the reversible step control. Throws
+/// std::invalid_argument for an unknown name (listing the known ones), a member without the
+/// control asked for, or bad settings.
 std::unique_ptr<CartStepper> make_cart_stepper(const IntegratorSettings& settings, const CartModel& model,
                                                const EffectSet& effects);
 

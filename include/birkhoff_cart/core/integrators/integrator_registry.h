@@ -1,0 +1,68 @@
+// The integrator registry: one table of the members (src/core/integrators/integrator_registry.cpp)
+// with what each one is and how it is built. Whatever lists, checks or builds a member reads it:
+// the scene loader, make_cart_stepper, cart_simulate's --help, the node, the benchmarks, the tests.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "birkhoff_cart/core/integrator_settings.h"
+
+namespace birkhoff_cart {
+
+class CartModel;
+class CartStepper;
+class EffectSet;
+
+/// The family of a member's scheme (docs/integrators.md).
+enum class IntegratorKind {
+  kBirkhoffianCollocation,  ///< s-stage Gauss–Legendre collocation in the Darboux chart (order 2s)
+  kComposition,             ///< a symmetric composition of birkhoff2 steps
+  kExplicitRungeKutta,      ///< an explicit Runge–Kutta method at steps of h
+  kAdaptive,                ///< an embedded pair with its own steps inside h, for `tolerance`
+  kImplicitMidpoint,        ///< the implicit midpoint rule on z, solved by Newton
+};
+
+/// "Birkhoffian collocation", "composition", "explicit RK", "adaptive", "implicit midpoint".
+const char* to_string(IntegratorKind kind);
+
+/// Builds a member's stepper for `model` and `effects` (both must outlive it) with `settings`
+/// (its form, Newton and collocation settings, dopri5's tolerance, the reversible control's).
+using CartStepperFactory = std::unique_ptr<CartStepper> (*)(const IntegratorSettings& settings,
+                                                            const CartModel& model, const EffectSet& effects);
+
+/// One member of the registry. The claims (order, symmetric, reversible) are checked against the
+/// steppers the factories build by integrator_registry_test (order measured, symmetry by reversal).
+struct IntegratorEntry {
+  const char* name;         ///< integrator.name, --integrator, ~integrator
+  int order;                ///< order of accuracy p [-] (dopri5: that of its 5th-order solution)
+  bool symmetric;           ///< time-symmetric (self-adjoint) step map
+  IntegratorKind kind;      ///< the family of its scheme
+  const char* description;  ///< one line for help texts
+  CartStepperFactory make_fixed;       ///< step_control fixed: steps of h
+  CartStepperFactory make_reversible;  ///< step_control reversible (docs/birkhoffian.md §11); null: not offered
+
+  /// Takes step_control reversible (the symmetric Birkhoffian members).
+  bool reversible() const { return make_reversible != nullptr; }
+  /// Reads `tolerance` (a local error tolerance [-]) instead of stepping at h alone.
+  bool takes_tolerance() const { return kind == IntegratorKind::kAdaptive; }
+};
+
+/// Every member, in the registry's order.
+const std::vector<IntegratorEntry>& integrator_registry();
+
+/// The member named `name`; nullptr when there is none.
+const IntegratorEntry* find_integrator(const std::string& name);
+
+/// The member named `name`. Throws std::invalid_argument naming it, listing the known names and
+/// the closest one to a typo ("unknown integrator 'rk5' (known: …; did you mean 'rk4'?)").
+const IntegratorEntry& integrator_entry(const std::string& name);
+
+/// Every member's name, in the registry's order.
+std::vector<std::string> integrator_names();
+
+/// The names of the members that take step_control reversible, in the registry's order.
+std::vector<std::string> reversible_integrator_names();
+
+}  // namespace birkhoff_cart

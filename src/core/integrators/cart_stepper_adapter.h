@@ -1,0 +1,142 @@
+// The CartStepper of a member at fixed steps: a generic stepper (runge_kutta.h, dopri5.h,
+// implicit_midpoint.h, gauss_collocation.h, birkhoff_symplectic.h) on one of the cart's Birkhoffian
+// systems (cart_birkhoffian.h), type-erased for the simulation. Private to the core library (the
+// registry, integrator_registry.cpp, makes them).
+#pragma once
+
+#include <array>
+#include <memory>
+#include <string>
+
+#include "birkhoff_cart/core/cart_model.h"
+#include "birkhoff_cart/core/effects.h"
+#include "birkhoff_cart/core/integrators/carried_state.h"
+#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "step_checks.h"
+
+namespace birkhoff_cart {
+namespace cart_stepper_adapter {
+
+using namespace stepper_checks;
+
+/// The command torques (steering, drive) [N·m] the effects read now; 0 for a source that is absent.
+inline std::array<double, 2> command_torques(const EffectSet& effects) {
+  return {effects.steering_command() ? effects.steering_command()->value : 0.0,
+          effects.drive_command() ? effects.drive_command()->value : 0.0};
+}
+
+/// What a fixed-step adapter reports of its stepper: its name, order and symmetry.
+template <class Stepper>
+class FixedStepCartStepper : public CartStepper {
+ public:
+  const std::string& name() const override { return name_; }
+  int order() const override { return Stepper::kOrder; }
+  bool symmetric() const override { return Stepper::kSymmetric; }
+
+ protected:
+  const std::string name_ = Stepper::name();
+};
+
+/// Generic stepper + cart system → CartStepper. Transactional: the state, the statistics and the
+/// stepper's own memory (dopri5's step-size guess) change only when the whole step succeeded.
+template <class Stepper, class System>
+class CartStepperAdapter final : public FixedStepCartStepper<Stepper> {
+  using FixedStepCartStepper<Stepper>::name_;
+
+ public:
+  CartStepperAdapter(const Stepper& stepper, const CartModel& model, const EffectSet& effects)
+      : stepper_(stepper), system_(model, effects) {}
+
+  void step(CartState& state, double step_size, StepStatistics& statistics) override {
+    require_valid_step_size(step_size);
+    const double time = state.time;  // tₖ [s]
+    system_.begin_step(time);        // rep (a): structure epoch tₑ = tₖ; rep (b): nothing
+    CartBirkhoffianPoint point = system_.to_birkhoffian(state);
+    Stepper trial = stepper_;
+    StepStatistics counted = statistics;
+    try {
+      trial.step(system_, point.z, point.y, time, step_size, counted);
+    } catch (const StepError& error) {
+      throw StepError(name_ + ": " + error.what());
+    }
+    require_finite_result(name_, time, step_size, point.z, point.y);
+    const CartState next = system_.to_cart_state(point.z, point.y, time + step_size);
+    require_finite_speeds(name_, time, step_size, next, point.z);
+    ++counted.steps;
+    state = next;
+    statistics = counted;
+    stepper_ = trial;
+  }
+
+ private:
+  Stepper stepper_;
+  System system_;
+};
+
+/// The Birkhoffian collocation members and compositions: the adapter carries the integrator's own
+/// state between steps (carried_state.h) — z and y with their compensated-summation remainders, χ
+/// and θ reduced modulo 2π with their turns apart, the stage-derivative memory — and uses it
+/// whenever the state handed in is the one it handed out; any other state (a reset, a state set by
+/// the caller) starts afresh from p = M(χ) ω. A failed step leaves the caller's state and statistics
+/// untouched and drops the carried state.
+template <class Stepper, class System>
+class CarriedCartStepperAdapter final : public FixedStepCartStepper<Stepper> {
+  using FixedStepCartStepper<Stepper>::name_;
+
+ public:
+  CarriedCartStepperAdapter(const Stepper& stepper, const CartModel& model, const EffectSet& effects)
+      : stepper_(stepper), system_(model, effects), effects_(effects) {}
+
+  void step(CartState& state, double step_size, StepStatistics& statistics) override {
+    require_valid_step_size(step_size);
+    const double time = state.time;  // tₖ [s]
+    system_.begin_step(time);
+    if (!carried_.continues(state)) carried_.start_from(system_, state);
+    // A new command changes ẇ at the same (w, t): the last step's F(w⁺) is not this step's F(w).
+    const std::array<double, 2> commands = command_torques(effects_);
+    if (commands != commands_) carried_.memory.forget_end_rate();
+    commands_ = commands;
+    StepStatistics counted = statistics;
+    counted.newton_iterations_last_step = 0;
+    // On any failure the carried state is dropped (the next step starts afresh from the caller's
+    // unchanged state): cheaper than copying the Newton matrices every step, and as deterministic.
+    carried_.valid = false;
+    try {
+      stepper_.advance_compensated(system_, carried_.point, carried_.memory, time, step_size, counted);
+    } catch (const StepError& error) {
+      throw StepError(name_ + ": " + error.what());
+    }
+    const auto& point = carried_.point;
+    require_finite_result(name_, time, step_size, point.z, point.y);
+    carried_.reduce_angles();
+    const CartState next = carried_.output(system_, time + step_size);
+    require_finite_speeds(name_, time, step_size, next, point.z);
+    carried_.valid = true;
+    ++counted.steps;
+    state = next;
+    statistics = counted;
+  }
+
+ private:
+  Stepper stepper_;
+  System system_;
+  const EffectSet& effects_;
+  std::array<double, 2> commands_{};  ///< command torques at the last step [N·m]
+  CarriedCartState<System, typename Stepper::template Memory<System>> carried_;
+};
+
+}  // namespace cart_stepper_adapter
+
+/// `stepper` on `System` at fixed steps: the adapter that carries the integrator's own state
+/// between steps where the stepper has one (the Birkhoffian members), the plain one otherwise.
+template <class Stepper, class System>
+std::unique_ptr<CartStepper> make_fixed_step_adapter(const Stepper& stepper, const CartModel& model,
+                                                     const EffectSet& effects) {
+  if constexpr (kCarriesState<Stepper, System>) {
+    return std::make_unique<cart_stepper_adapter::CarriedCartStepperAdapter<Stepper, System>>(stepper, model, effects);
+  } else {
+    return std::make_unique<cart_stepper_adapter::CartStepperAdapter<Stepper, System>>(stepper, model, effects);
+  }
+}
+
+}  // namespace birkhoff_cart
