@@ -78,20 +78,21 @@ std::string alternatives(const std::vector<std::string>& names, const std::strin
 }
 
 /// The registry's members, one line each: name, order, symmetric, takes the reversible control,
-/// kind, scheme. The members that take --step-control reversible come first.
+/// evaluates its stages together, kind, scheme. The members that take --step-control reversible come first.
 std::string integrator_table() {
   std::vector<birkhoff_cart::IntegratorEntry> members = birkhoff_cart::integrator_registry();
   std::stable_partition(members.begin(), members.end(),
                         [](const birkhoff_cart::IntegratorEntry& member) { return member.reversible(); });
   std::string table =
       "Integrators (--integrator NAME; docs/integrators.md). p: the order; symmetric: a time-symmetric\n"
-      "step map; reversible: takes --step-control reversible.\n"
-      "  NAME                p  symmetric  reversible  kind                     scheme\n";
+      "step map; reversible: takes --step-control reversible; vector: evaluates its stages together,\n"
+      "with one vector sin/cos where the CPU has AVX2.\n"
+      "  NAME                p  symmetric  reversible  vector  kind                     scheme\n";
   for (const birkhoff_cart::IntegratorEntry& member : members) {
     char line[200];
-    std::snprintf(line, sizeof line, "  %-19s %-2d %-10s %-11s %-24s %s\n", member.name, member.order,
+    std::snprintf(line, sizeof line, "  %-19s %-2d %-10s %-11s %-7s %-24s %s\n", member.name, member.order,
                   member.symmetric ? "yes" : "no", member.reversible() ? "yes" : "no",
-                  birkhoff_cart::to_string(member.kind), member.description);
+                  member.vector_stages ? "yes" : "no", birkhoff_cart::to_string(member.kind), member.description);
     table += line;
   }
   return table;

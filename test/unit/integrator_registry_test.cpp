@@ -26,6 +26,7 @@
 #include "birkhoff_cart/core/integrators/integrator_registry.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/vector_math.h"
 #include "test_scenes.h"
 
 namespace birkhoff_cart {
@@ -213,6 +214,17 @@ TEST_P(RegistryRow, HelpShowsTheRowsOrderSymmetryAndReversibleControl) {
   EXPECT_EQ(reversible, member.reversible() ? "yes" : "no") << member.name;
   EXPECT_NE(help.find(member.description, at), std::string::npos) << member.name;
   EXPECT_NE(help.find(to_string(member.kind), at), std::string::npos) << member.name;
+}
+
+TEST_P(RegistryRow, VectorStagesIsWhereTheStagesAreEvaluatedTogether) {
+  const IntegratorEntry& member = GetParam();
+  // The claim: the Gauss members from two stages on evaluate their stages together.
+  EXPECT_EQ(member.vector_stages, member.kind == IntegratorKind::kBirkhoffianCollocation && member.order >= 4)
+      << member.name;
+  // Checked on the stepper: it calls the stage batch (sin_cos_lanes) exactly when the row says so.
+  const std::uint64_t before = sin_cos_lanes_calls();
+  run_steps(load("sine_steer_torque"), fixed_settings(member), 20);
+  EXPECT_EQ(sin_cos_lanes_calls() > before, member.vector_stages) << member.name;
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryMember, RegistryRow, testing::ValuesIn(members()),

@@ -74,37 +74,53 @@ std::unique_ptr<CartStepper> reversible_step(const IntegratorSettings& settings,
                                                                                            effects);
 }
 
+/// Does the member evaluate its stages together (GaussCollocation::kEvaluatesStagesTogether)?
+template <class Stepper, class = void>
+struct StagesTogether : std::false_type {};
+template <class Stepper>
+struct StagesTogether<Stepper, std::void_t<decltype(Stepper::kEvaluatesStagesTogether)>>
+    : std::integral_constant<bool, Stepper::kEvaluatesStagesTogether> {};
+template <class Stepper>
+constexpr bool vector_stages = StagesTogether<Stepper>::value;
+
 using Kind = IntegratorKind;
 
 }  // namespace
 
 const std::vector<IntegratorEntry>& integrator_registry() {
   // The members, in the registry's order (integrator_names(), the help, the tests' cases): name,
-  // order p, symmetric, kind, description, factory at fixed steps, factory under reversible control.
+  // order p, symmetric, kind, description, factory at fixed steps, factory under reversible control,
+  // stages evaluated together (from the stepper's type).
   // A function's static: built at the first call, whichever static initializer asks first.
   static const std::vector<IntegratorEntry> kRegistry = {
       {"birkhoff2", 2, true, Kind::kBirkhoffianCollocation, "Su's scheme: 1-stage Gauss in the chart",
-       fixed_step<GaussCollocation<1>>, reversible_step<GaussCollocation<1>>},
+       fixed_step<GaussCollocation<1>>, reversible_step<GaussCollocation<1>>, vector_stages<GaussCollocation<1>>},
       {"birkhoff4", 4, true, Kind::kComposition, "triple jump of birkhoff2",
-       fixed_step<BirkhoffComposition<TripleJumpWeights>>, reversible_step<BirkhoffComposition<TripleJumpWeights>>},
-      {"rk2", 2, false, Kind::kExplicitRungeKutta, "Heun's method", fixed_step<HeunRungeKutta2>, nullptr},
-      {"rk4", 4, false, Kind::kExplicitRungeKutta, "classical Runge-Kutta", fixed_step<ClassicalRungeKutta4>, nullptr},
+       fixed_step<BirkhoffComposition<TripleJumpWeights>>, reversible_step<BirkhoffComposition<TripleJumpWeights>>,
+       vector_stages<BirkhoffComposition<TripleJumpWeights>>},
+      {"rk2", 2, false, Kind::kExplicitRungeKutta, "Heun's method", fixed_step<HeunRungeKutta2>, nullptr,
+       vector_stages<HeunRungeKutta2>},
+      {"rk4", 4, false, Kind::kExplicitRungeKutta, "classical Runge-Kutta", fixed_step<ClassicalRungeKutta4>, nullptr,
+       vector_stages<ClassicalRungeKutta4>},
       {"dopri5", 5, false, Kind::kAdaptive, "Dormand-Prince 5(4) of Boost.Odeint", fixed_step<DormandPrince5>,
-       nullptr},
+       nullptr, vector_stages<DormandPrince5>},
       {"midpoint", 2, true, Kind::kImplicitMidpoint, "implicit midpoint rule on z", fixed_step<ImplicitMidpoint>,
-       nullptr},
+       nullptr, vector_stages<ImplicitMidpoint>},
       {"birkhoff_gauss4", 4, true, Kind::kBirkhoffianCollocation, "2-stage Gauss-Legendre in the chart",
-       fixed_step<GaussCollocation<2>>, reversible_step<GaussCollocation<2>>},
+       fixed_step<GaussCollocation<2>>, reversible_step<GaussCollocation<2>>, vector_stages<GaussCollocation<2>>},
       {"birkhoff_gauss6", 6, true, Kind::kBirkhoffianCollocation, "3-stage Gauss-Legendre in the chart",
-       fixed_step<GaussCollocation<3>>, reversible_step<GaussCollocation<3>>},
+       fixed_step<GaussCollocation<3>>, reversible_step<GaussCollocation<3>>, vector_stages<GaussCollocation<3>>},
       {"birkhoff_gauss8", 8, true, Kind::kBirkhoffianCollocation, "4-stage Gauss-Legendre in the chart",
-       fixed_step<GaussCollocation<4>>, reversible_step<GaussCollocation<4>>},
+       fixed_step<GaussCollocation<4>>, reversible_step<GaussCollocation<4>>, vector_stages<GaussCollocation<4>>},
       {"birkhoff4_suzuki", 4, true, Kind::kComposition, "Suzuki's 5 stages of birkhoff2",
-       fixed_step<BirkhoffComposition<SuzukiFiveWeights>>, reversible_step<BirkhoffComposition<SuzukiFiveWeights>>},
+       fixed_step<BirkhoffComposition<SuzukiFiveWeights>>, reversible_step<BirkhoffComposition<SuzukiFiveWeights>>,
+       vector_stages<BirkhoffComposition<SuzukiFiveWeights>>},
       {"birkhoff6_kahan_li", 6, true, Kind::kComposition, "Kahan & Li's 9 stages of birkhoff2",
-       fixed_step<BirkhoffComposition<KahanLiSixWeights>>, reversible_step<BirkhoffComposition<KahanLiSixWeights>>},
+       fixed_step<BirkhoffComposition<KahanLiSixWeights>>, reversible_step<BirkhoffComposition<KahanLiSixWeights>>,
+       vector_stages<BirkhoffComposition<KahanLiSixWeights>>},
       {"birkhoff8_kahan_li", 8, true, Kind::kComposition, "Kahan & Li's 17 stages of birkhoff2",
-       fixed_step<BirkhoffComposition<KahanLiEightWeights>>, reversible_step<BirkhoffComposition<KahanLiEightWeights>>},
+       fixed_step<BirkhoffComposition<KahanLiEightWeights>>, reversible_step<BirkhoffComposition<KahanLiEightWeights>>,
+       vector_stages<BirkhoffComposition<KahanLiEightWeights>>},
   };
   return kRegistry;
 }

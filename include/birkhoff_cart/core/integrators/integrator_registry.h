@@ -42,6 +42,9 @@ struct IntegratorEntry {
   const char* description;  ///< one line for help texts
   CartStepperFactory make_fixed;       ///< step_control fixed: steps of h
   CartStepperFactory make_reversible;  ///< step_control reversible (docs/birkhoffian.md §11); null: not offered
+  /// Evaluates the s stages' right-hand sides of an iteration together, with one vector sin/cos on
+  /// CPUs with AVX2 (vector_math.h; docs/integrators.md, "Stage evaluation").
+  bool vector_stages;
 
   /// Takes step_control reversible (the symmetric Birkhoffian members).
   bool reversible() const { return make_reversible != nullptr; }
