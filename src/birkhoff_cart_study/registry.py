@@ -21,7 +21,7 @@ class Registry(collections.namedtuple("Registry", "members forms step_controls")
         return [member.name for member in self.members if member.kind == "adaptive"]
 
 
-HEADER = re.compile(r"^  NAME +p +symmetric +reversible +kind +scheme$", re.M)
+HEADER = re.compile(r"^  NAME +p +symmetric +reversible +(?:vector +)?kind +scheme$", re.M)
 ROW = re.compile(r"^  ([a-z][a-z0-9_]*) +(\d+) +(yes|no) +(yes|no) +(.*)$")
 
 
