@@ -136,9 +136,11 @@ runs_start=$SECONDS
 bin="$workspace/devel/lib/birkhoff_cart"
 # The binaries find libbirkhoff_cart_core.so through RUNPATH, which LD_LIBRARY_PATH overrides: a
 # caller that sourced another workspace's devel/setup.bash (scripts/run_tests.sh does) would have
-# them load that uninstrumented library. This workspace's library comes first, and is checked.
+# them load that uninstrumented library. This workspace's library comes first, and is checked
+# (on ldd's whole output: piped into `grep -q`, which exits at the match, ldd could die of SIGPIPE
+# and pipefail would count the pipeline failed).
 export LD_LIBRARY_PATH="$workspace/devel/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
-if $self_check_only; then :; elif ! ldd "$bin/cart_simulate" | grep -q "libbirkhoff_cart_core.so => $workspace/devel/lib/"; then
+if $self_check_only; then :; elif ! grep -q "libbirkhoff_cart_core.so => $workspace/devel/lib/" <<<"$(ldd "$bin/cart_simulate")"; then
   echo "sanitize: cart_simulate does not load the sanitized libbirkhoff_cart_core.so of $workspace:" >&2
   ldd "$bin/cart_simulate" | grep birkhoff >&2
   echo "0 passed, 1 failed"
