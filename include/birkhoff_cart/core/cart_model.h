@@ -105,10 +105,8 @@ class CartModel {
                                             const Vector2<Scalar>& quasi_velocity) const {
     using std::cos;
     using std::sin;
-    // ∂T*/∂χ|_ω = −Λ_nh,2 exactly (negation is exact in floating point).
-    const Scalar s = sin(steering_angle);
-    const Scalar c = cos(steering_angle);
-    return -nonholonomic_force_at(s, c, quasi_velocity)(1);
+    return kinetic_energy_steering_derivative_at(Scalar(sin(steering_angle)), Scalar(cos(steering_angle)),
+                                                 quasi_velocity);
   }
 
   /// ṗ = ∂T*/∂q|_ω + Λ_nh + Q summed in closed form (eq. (3.6)): the χ-row of ∂T*/∂q|_ω cancels
@@ -211,7 +209,8 @@ class CartModel {
     return quasi_velocity(0) * s / parameters_.wheelbase;
   }
 
-  /// ∂T*/∂χ at constant ω from s = sin χ, c = cos χ.
+  /// ∂T*/∂χ at constant ω from s = sin χ, c = cos χ: −Λ_nh,2 exactly (negation is exact in
+  /// floating point).
   template <class Scalar>
   Scalar kinetic_energy_steering_derivative_at(const Scalar& s, const Scalar& c,
                                                const Vector2<Scalar>& quasi_velocity) const {

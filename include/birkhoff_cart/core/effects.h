@@ -111,12 +111,8 @@ class EffectSet {
       result.setConstant(S(0.0) * steering_angle);
       return result;
     }
-    EffectInput input;
-    input.time = time;
-    input.steering_angle = value_of(steering_angle);
-    input.forward_speed = value_of(quasi_velocity(0));
-    input.steering_rate = value_of(quasi_velocity(1));
-    const GeneralizedForce total = evaluate(input);
+    const GeneralizedForce total = force_and_jacobian(
+        time, value_of(steering_angle), Vector2<double>(value_of(quasi_velocity(0)), value_of(quasi_velocity(1))));
     const S inputs[3] = {steering_angle, quasi_velocity(0), quasi_velocity(1)};
     for (int row = 0; row < 2; ++row) {
       const double partials[3] = {total.jacobian(row, 0), total.jacobian(row, 1), total.jacobian(row, 2)};

@@ -39,8 +39,8 @@ void set_stage_evaluation(StageEvaluation evaluation);
 /// sines[i] = sin(angles[i]), cosines[i] = cos(angles[i]) for i < count ≤ kMaxVectorLanes [rad → -].
 void sin_cos_lanes(const double* angles, int count, double* sines, double* cosines);
 
-/// Calls of sin_cos_lanes in this process so far, on either path (which members evaluate their
-/// stages together: integrator_registry_test).
+/// Calls of sin_cos_lanes in the calling thread so far, on either path (which members evaluate
+/// their stages together: integrator_registry_test).
 std::uint64_t sin_cos_lanes_calls();
 
 }  // namespace birkhoff_cart

@@ -48,12 +48,12 @@ std::array<Real, kMaxGaussStages> legendre_roots(int s) {
   return roots;
 }
 
-/// ℓⱼ(τ) on `points` (count of them).
-template <class Point>
-Real lagrange_basis(const std::array<Point, kMaxGaussStages>& points, int count, int j, Real tau) {
-  Real value = 1.0L;
+/// ℓⱼ(τ) on `points` (count of them), in the arithmetic of Number (long double for the tableau).
+template <class Point, class Number = Real>
+Number lagrange_basis(const std::array<Point, kMaxGaussStages>& points, int count, int j, Number tau) {
+  Number value = 1.0;
   for (int m = 0; m < count; ++m) {
-    if (m != j) value *= (tau - points[m]) / (static_cast<Real>(points[j]) - points[m]);
+    if (m != j) value *= (tau - points[m]) / (static_cast<Number>(points[j]) - points[m]);
   }
   return value;
 }
@@ -136,7 +136,7 @@ const GaussLegendreTableau& gauss_legendre_tableau(int stages) {
 std::array<double, kMaxGaussStages> lagrange_basis_values(const std::array<double, kMaxGaussStages>& points, int count,
                                                           double tau) {
   std::array<double, kMaxGaussStages> values{};
-  for (int j = 0; j < count; ++j) values[j] = static_cast<double>(lagrange_basis(points, count, j, tau));
+  for (int j = 0; j < count; ++j) values[j] = lagrange_basis<double, double>(points, count, j, tau);
   return values;
 }
 

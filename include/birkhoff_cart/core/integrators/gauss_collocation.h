@@ -61,7 +61,6 @@
 #include "birkhoff_cart/core/integrators/gauss_legendre_tableau.h"
 #include "birkhoff_cart/core/integrators/kronecker_newton.h"
 #include "birkhoff_cart/core/integrators/newton.h"
-#include "birkhoff_cart/core/integrators/small_inverse.h"
 
 namespace birkhoff_cart {
 
@@ -358,22 +357,12 @@ class GaussCollocation {
       // polynomial's increments, not ∫P: for s = 1 the stage sees F at the midpoint only).
       std::array<double, kMaxGaussStages> points{};  // memory times in units of h from tₖ
       for (int m = 0; m < memory.count; ++m) points[m] = (memory.times[m] - t) / h;
-      // Fⱼ⁽⁰⁾ = Σₘ Lₘ(cⱼ) Fₘ with the Lagrange basis Lₘ of the points, in double (a starting guess
-      // needs no more), and plain loops over the components.
-      std::array<std::array<double, kMaxGaussStages>, Stages> basis{};  // Lₘ(cⱼ)
+      // Fⱼ⁽⁰⁾ = Σₘ Lₘ(cⱼ) Fₘ, in plain loops over the components.
       for (int j = 0; j < Stages; ++j) {
-        for (int m = 0; m < memory.count; ++m) {
-          double value = 1.0;
-          for (int q = 0; q < memory.count; ++q) {
-            if (q != m) value *= (tableau.nodes[j] - points[q]) / (points[m] - points[q]);
-          }
-          basis[j][m] = value;
-        }
-      }
-      for (int j = 0; j < Stages; ++j) {
+        const std::array<double, kMaxGaussStages> basis = lagrange_basis_values(points, memory.count, tableau.nodes[j]);
         for (int k = 0; k < W::RowsAtCompileTime; ++k) {
           double rate = 0.0;
-          for (int m = 0; m < memory.count; ++m) rate += basis[j][m] * memory.rates[m](k);
+          for (int m = 0; m < memory.count; ++m) rate += basis[m] * memory.rates[m](k);
           stage_rates[j](k) = S(rate);
         }
       }
@@ -619,8 +608,8 @@ class GaussCollocation {
         matrix.template block<n, n>(i * n, j * n) -= (h * tableau.coefficients[i][j]) * jacobian;
       }
     }
-    Matrix inverse;
-    if (!invert_small_matrix<n * Stages>(matrix, inverse)) fail("met a singular Newton matrix", t, 0);
+    const Matrix inverse = matrix.partialPivLu().inverse();
+    if (!inverse.allFinite()) fail("met a singular Newton matrix", t, 0);
     return inverse;
   }
 

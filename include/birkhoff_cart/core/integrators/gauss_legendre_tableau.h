@@ -42,7 +42,7 @@ struct GaussLegendreTableau {
 const GaussLegendreTableau& gauss_legendre_tableau(int stages);
 
 /// ℓⱼ(τ) for the Lagrange basis on the distinct abscissae `points`, j < count (extrapolation of stage
-/// derivatives to the next step's stage times, eq. (B.32)).
+/// derivatives to the next step's stage times, eq. (B.32)), in double: a starting guess needs no more.
 std::array<double, kMaxGaussStages> lagrange_basis_values(const std::array<double, kMaxGaussStages>& points, int count,
                                                           double tau);
 

@@ -21,12 +21,12 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/LU>
 #include <array>
 #include <cmath>
 #include <type_traits>
 #include <utility>
 
-#include "birkhoff_cart/core/integrators/small_inverse.h"
 
 namespace birkhoff_cart {
 
@@ -55,13 +55,15 @@ class KroneckerNewtonInverse {
         active_[m_++] = k;
       }
     }
-    return with_block_size([&](auto block) { return build_block<decltype(block)::value>(jacobian, coefficients, h); });
+    return with_block_size(m_, [&](auto block) {
+      return build_block<decltype(block)::value>(jacobian, coefficients, h);
+    });
   }
 
   /// correction = M⁻¹ residual, both s blocks of n (stage by stage). Any scalar S (AD jets too).
   template <class S>
   void apply(const std::array<S, n * s>& residual, std::array<S, n * s>& correction) const {
-    with_block_size([&](auto block) {
+    with_block_size(m_, [&](auto block) {
       apply_block<decltype(block)::value>(residual, correction);
       return true;
     });
@@ -125,8 +127,9 @@ class KroneckerNewtonInverse {
         for (int j = 0; j < s; ++j) denominator(i, j) += coefficient * x_power[k][i][j];
       }
     }
-    Eigen::Matrix<double, s, s> denominator_inverse;
-    if (!invert_small_matrix<s>(denominator, denominator_inverse)) return false;
+    // Eigen's closed-form inverse for s ≤ 4; a singular D gives non-finite entries (checked below).
+    const Eigen::Matrix<double, s, s> denominator_inverse = denominator.inverse();
+    if (!denominator_inverse.allFinite()) return false;
     std::array<Square, n + 1> y{};
     for (int k = 0; k <= m; ++k) {
       for (int i = 0; i < s; ++i) {
@@ -207,23 +210,16 @@ class KroneckerNewtonInverse {
     }
   }
 
-  /// f(std::integral_constant<int, m_>) for the block size in use.
-  template <class F>
-  bool with_block_size(F&& f) const {
-    return dispatch_block_size<n>(std::forward<F>(f));
-  }
-  template <int m, class F>
-  bool dispatch_block_size(F&& f) const {
+  /// f(std::integral_constant<int, size>) for the block size in use, so that the loops over the
+  /// block have constant bounds; false when no block size ≤ m matches (none: m_ ≥ 1 always).
+  template <int m = n, class F>
+  static bool with_block_size(int size, F&& f) {
     if constexpr (m >= 1) {
-      if (m_ == m) return f(std::integral_constant<int, m>{});
-      return dispatch_block_size<m - 1>(std::forward<F>(f));
+      if (size == m) return f(std::integral_constant<int, m>{});
+      return with_block_size<m - 1>(size, std::forward<F>(f));
     } else {
       return false;
     }
-  }
-  template <class F>
-  bool with_block_size(F&& f) {
-    return static_cast<const KroneckerNewtonInverse&>(*this).with_block_size(std::forward<F>(f));
   }
 
   bool all_finite() const {
