@@ -97,7 +97,7 @@ MUTATIONS = [
     Mutation(
         "passive_rates_at_first_stage",
         "the passive coordinates (x, y, θ, φ) are integrated with every stage's rate taken at the first stage",
-        "include/birkhoff_cart/core/integrators/gauss_collocation.h",
+        "include/birkhoff_cart/core/integrators/passive_quadrature.h",
         "passive_rates[j] = passive_coordinate_rates(system, stage_points[j], passive_stages[j], S(stage_times[j]));",
         "passive_rates[j] = passive_coordinate_rates(system, stage_points[0], passive_stages[0], S(stage_times[0]));",
         [(TRAJECTORY, "*"), ("integrator_contract_test", "*")],
@@ -114,9 +114,9 @@ MUTATIONS = [
         "compensated_summation_dropped",
         "the compensated (TwoSum) state update silently falls back to plain summation",
         "include/birkhoff_cart/core/integrators/gauss_collocation.h",
-        "const bool compensate = settings_.compensated && collocation_detail::LinearChart<System>::value;\n"
+        "const bool compensate = settings_.compensated && system_traits::kDarbouxChartIsLinear<System>;\n"
         "    if (!compensate) {",
-        "const bool compensate = false && settings_.compensated && collocation_detail::LinearChart<System>::value;\n"
+        "const bool compensate = false && settings_.compensated && system_traits::kDarbouxChartIsLinear<System>;\n"
         "    if (!compensate) {",
         [("gauss_collocation_test", "*")],
     ),
@@ -129,12 +129,30 @@ MUTATIONS = [
         [("gauss_collocation_test", "*"), ("long_run_test", "*")],
     ),
     Mutation(
-        "reversible_rho_update",
-        "the reversible step control's second half-update of ρ is dropped (the map is no longer symmetric)",
-        "include/birkhoff_cart/core/integrators/reversible_step_control.h",
-        "rho_ = rho_half + 0.5 * epsilon * log_rate_;",
-        "rho_ = rho_half;",
+        "time_transform_passive_rates",
+        "the time transformation scales ż by 1/σ but not the passive rates ẏ (positions advance in fictive time)",
+        "include/birkhoff_cart/core/integrators/time_transformed_system.h",
+        "passive_coordinate_rates(*system_, z, BasePassive<S>(y.template head<System::kPassiveDimension>()), t) *\n"
+        "        inverse_density;",
+        "passive_coordinate_rates(*system_, z, BasePassive<S>(y.template head<System::kPassiveDimension>()), t) *\n"
+        "        S(1.0);",
         [("reversible_step_control_test", "*")],
+    ),
+    Mutation(
+        "adaptive_accepts_every_step",
+        "the error-per-step control accepts a step whatever its estimate says",
+        "include/birkhoff_cart/core/integrators/adaptive_step_control.h",
+        "if (!solved || !finite_point() || !(ratio <= 1.0) ||",
+        "if (!solved || !finite_point() || !(ratio <= 1e30) ||",
+        [("adaptive_step_control_test", "*")],
+    ),
+    Mutation(
+        "compensated_remainder_counted_twice",
+        "the compensated update counts the carried remainder once more for each stage weight (odd s)",
+        "include/birkhoff_cart/core/integrators/gauss_collocation.h",
+        "W increment = S(tableau.remainder_weight) * w_remainder;",
+        "W increment = w_remainder;",
+        [("gauss_collocation_test", "*")],
     ),
     Mutation(
         "error_estimate_weights",

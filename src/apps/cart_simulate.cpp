@@ -102,6 +102,7 @@ std::string usage() {
   using birkhoff_cart::StepControl;
   const std::string fixed = birkhoff_cart::to_string(StepControl::kFixed);
   const std::string reversible = birkhoff_cart::to_string(StepControl::kReversible);
+  const std::string adaptive = birkhoff_cart::to_string(StepControl::kAdaptive);
   return "usage: cart_simulate --scene FILE [--integrator NAME] [--step H] [--tolerance TOL]\n"
          "                     [--duration T] [--output-rate HZ] [--birkhoffian-form F] [--quiet]\n"
          "                     [--step-control " + alternatives(birkhoff_cart::step_control_names(), "|", "|") +
@@ -110,13 +111,15 @@ std::string usage() {
          "       cart_simulate --help | -h | --version\n"
          "  --scene FILE            scene YAML (config/scenes/*.yaml); it provides every default\n"
          "  --integrator NAME       a member of the registry (below)\n"
-         "  --step H                step size [s], > 0; 1/HZ must be a whole multiple of it\n"
+         "  --step H                step size [s], > 0; 1/HZ must be a whole multiple of it (fixed steps only)\n"
          "  --tolerance TOL         dopri5's absolute and relative local tolerance [-], >= 10 machine epsilon\n"
          "                          (2.2e-15); refused for the fixed-step members\n"
-         "  --step-control C        " + fixed + " (steps of H) or " + reversible +
-         " (symmetric Birkhoffian members: their own\n"
-         "                          steps for --position-tolerance, H is then the output step; docs/accuracy.md §4)\n"
-         "  --position-tolerance M  " + reversible + " step control: the position error [m] allowed at the horizon\n"
+         "  --step-control C        " + fixed + " (steps of H), " + reversible +
+         " (symmetric Birkhoffian members, free runs) or\n"
+         "                          " + adaptive + " (Birkhoffian members and dopri5, any scene): their own\n"
+         "                          steps for --position-tolerance, rows at any --output-rate (docs/accuracy.md §4)\n"
+         "  --position-tolerance M  " + reversible + " or " + adaptive +
+         " step control: the position error [m] allowed at the horizon\n"
          "  --duration T            simulated time after the start [s], > 0\n"
          "  --output-rate HZ        output rows per simulated second [Hz], > 0\n"
          "  --birkhoffian-form F    " + alternatives(birkhoff_cart::birkhoffian_form_names(), ", ", " or ") + "\n"
@@ -239,23 +242,32 @@ void apply_overrides(const std::map<std::string, std::string>& arguments, Scene&
   }
   // Each tolerance means one thing and is refused where it would be ignored.
   const birkhoff_cart::IntegratorSettings& settings = scene.integrator;
-  const bool reversible = settings.step_control == birkhoff_cart::StepControl::kReversible;
+  const bool controlled = settings.step_control != birkhoff_cart::StepControl::kFixed;
+  const std::string control = birkhoff_cart::to_string(settings.step_control);
   const birkhoff_cart::IntegratorEntry* member = birkhoff_cart::find_integrator(settings.name);
   if (arguments.count("--tolerance") && !(member != nullptr && member->takes_tolerance())) {
     throw UsageError("option --tolerance is dopri5's local tolerance [-]; " + settings.name + " steps at " +
-                     (reversible ? "the reversible step control's steps: give the position error [m] with "
-                                   "--position-tolerance M"
-                                 : "--step H (fixed steps; the symmetric Birkhoffian members choose their own "
-                                   "steps for a position error with --step-control reversible --position-tolerance M)"));
+                     (controlled ? "the " + control + " step control's steps: give the position error [m] with "
+                                                      "--position-tolerance M"
+                                 : std::string("--step H (fixed steps; the Birkhoffian members choose their own "
+                                               "steps for a position error with --step-control adaptive or "
+                                               "reversible --position-tolerance M)")));
   }
-  if (arguments.count("--position-tolerance") && !reversible) {
-    throw UsageError("option --position-tolerance is the position error [m] for --step-control reversible; the run "
-                     "steps at fixed steps of --step H");
+  if (arguments.count("--position-tolerance") && !controlled) {
+    throw UsageError("option --position-tolerance is the position error [m] for --step-control adaptive or "
+                     "reversible; the run steps at fixed steps of --step H");
   }
-  if (reversible && !(settings.position_tolerance > 0.0)) {
-    throw UsageError("option --step-control reversible needs --position-tolerance M (the position error [m] allowed "
-                     "at the horizon)");
+  if (controlled && !(settings.position_tolerance > 0.0)) {
+    throw UsageError("option --step-control " + control +
+                     " needs --position-tolerance M (the position error [m] allowed at the horizon)");
   }
+  if (controlled && arguments.count("--step")) {
+    throw UsageError("option --step is the fixed-step members' step; under --step-control " + control +
+                     " the member chooses its own steps and the rows come at --output-rate HZ");
+  }
+  // Under a step control the output step is the row interval: the rows need not fall on any step
+  // of the member's (its dense output), so the scene's step_size does not constrain them.
+  if (controlled) scene.integrator.step_size = 1.0 / scene.output_rate;
 }
 
 /// The scene key a time limit blames, with the option that may have set it.
