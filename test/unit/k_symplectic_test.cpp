@@ -1,7 +1,8 @@
 // The defining property of the generalized symplectic schemes (docs/birkhoffian.md §7, (B.14)):
 // for Λ = 0 the Jacobian M = ∂z⁽ᵏ⁺¹⁾/∂z⁽ᵏ⁾ of one step, taken by forward-mode AD through the whole
 // step (Newton included), satisfies Mᵀ K(z⁽ᵏ⁺¹⁾, tₖ₊₁) M = K(z⁽ᵏ⁾, tₖ). Every Birkhoffian member of
-// the registry (integrator_members.h) passes on every system; rk4, the midpoint rule in z and
+// the registry (integrator_members.h) passes on every system (the test oscillators, the cart's two
+// forms and the example system, the Chaplygin sleigh, in its two); rk4, the midpoint rule in z and
 // birkhoff2 in the wrong (identity) chart fail by orders of magnitude, so the check can fail. Also:
 // symmetry (+h then −h) and the α-mapping identity (B.13).
 #include <gtest/gtest.h>
@@ -17,6 +18,7 @@
 #include "birkhoff_cart/core/cart_birkhoffian.h"
 #include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/effects.h"
+#include "birkhoff_cart/core/examples/chaplygin_sleigh.h"
 #include "birkhoff_cart/core/integrators/birkhoff_symplectic.h"
 #include "birkhoff_cart/core/integrators/implicit_midpoint.h"
 #include "birkhoff_cart/core/integrators/runge_kutta.h"
@@ -128,6 +130,17 @@ struct CartFixture {
   }
 };
 
+/// The Chaplygin sleigh (examples/chaplygin_sleigh.h) in the form with conformal rate γ [1/s]
+/// (0: autonomous, 1: the paper's eᵗ form), with or without the blade's reaction Λ.
+ChaplyginSleigh sleigh_form(double gamma, bool with_blade) {
+  ChaplyginSleighParameters parameters;
+  parameters.conformal_rate = gamma;
+  ChaplyginSleigh sleigh(parameters);
+  sleigh.set_non_birkhoffian_force_enabled(with_blade);
+  return sleigh;
+}
+ChaplyginSleigh sleigh_birkhoffian_part(double gamma) { return sleigh_form(gamma, false); }
+
 const double kStepSizes[] = {1e-3, 1e-2, 0.1};  // h [s]
 // A non-K-symplectic one-step map misses by O(h^{p+1}) per step (rk4: ~1e-16 at h = 1e-3, i.e.
 // round-off): the violation checks use steps where that is far above round-off.
@@ -167,6 +180,18 @@ void expect_k_symplectic_on_all_systems(const Stepper& stepper, double tolerance
       worst = std::max({worst, da, db});
     }
   }
+  // The example system: the Chaplygin sleigh's Birkhoffian part in the autonomous and the eᵗ form.
+  for (double gamma : {0.0, 1.0}) {
+    const ChaplyginSleigh sleigh = sleigh_birkhoffian_part(gamma);
+    for (double h : kStepSizes) {
+      for (int trial = 0; trial < 3; ++trial) {
+        const Eigen::Vector4d z = sleigh.state(uniform(random), uniform(random), uniform(random), uniform(random));
+        const double d = symplecticity_defect(stepper, sleigh, z, uniform(random), h, statistics);
+        EXPECT_LE(d, tolerance) << "sleigh gamma = " << gamma << " h = " << h;
+        worst = std::max(worst, d);
+      }
+    }
+  }
   std::printf("[ measured ] %s: worst K-symplecticity defect %.3e; Newton iterations %llu over %llu rhs evaluations\n",
               Stepper::name(), worst, static_cast<unsigned long long>(statistics.newton_iterations_total),
               static_cast<unsigned long long>(statistics.rhs_evaluations));
@@ -198,6 +223,11 @@ TYPED_TEST(BirkhoffianMember, ForwardThenBackwardStepReturnsToTheStart) {
     for (const Eigen::Vector4d& zc : cart.states) {
       EXPECT_LE(symmetry_defect(this->stepper_, full_a, zc, 7.0, h), kSymmetryTolerance) << h;
       EXPECT_LE(symmetry_defect(this->stepper_, full_b, zc, 7.0, h), kSymmetryTolerance) << h;
+    }
+    for (double gamma : {0.0, 1.0}) {  // the sleigh with its blade, both forms
+      const ChaplyginSleigh sleigh = sleigh_form(gamma, true);
+      EXPECT_LE(symmetry_defect(this->stepper_, sleigh, sleigh.state(0.2, 0.4, -0.5, 1.7), 0.8, h), kSymmetryTolerance)
+          << "sleigh gamma = " << gamma << " h = " << h;
     }
   }
 }
@@ -233,6 +263,25 @@ TEST(KSymplecticity, NonlinearTimeDependentChartSeparatesBirkhoffFromRk4AndMidpo
                 h, birkhoff2, birkhoff4, rk4, midpoint);
     EXPECT_LE(birkhoff2, kSymplecticityTolerance) << "h = " << h;
     EXPECT_LE(birkhoff4, kSymplecticityTolerance) << "h = " << h;
+    EXPECT_GE(rk4, kViolationFactor * kSymplecticityTolerance) << "h = " << h;
+    EXPECT_GE(midpoint, kViolationFactor * kSymplecticityTolerance) << "h = " << h;
+  }
+}
+
+TEST(KSymplecticity, TheSleighsPaperFormSeparatesBirkhoffFromRk4AndMidpointInZ) {
+  // The sleigh's eᵗ form (K = eᵗ K₀, chart w = (q, eᵗ p)): the Birkhoffian members pass
+  // (BirkhoffianMember.PreservesTheStructureOnEverySystem); rk4 and the midpoint rule in z, which do
+  // not step in the chart, fail it by orders of magnitude.
+  StepStatistics statistics;
+  const ChaplyginSleigh sleigh = sleigh_birkhoffian_part(1.0);
+  const Eigen::Vector4d z = sleigh.state(0.3, -0.2, 0.8, -1.1);
+  for (double h : kViolationStepSizes) {
+    const double birkhoff2 = symplecticity_defect(BirkhoffSymplectic2{}, sleigh, z, 0.4, h, statistics);
+    const double rk4 = symplecticity_defect(ClassicalRungeKutta4{}, sleigh, z, 0.4, h, statistics);
+    const double midpoint = symplecticity_defect(ImplicitMidpoint{}, sleigh, z, 0.4, h, statistics);
+    std::printf("[ measured ] sleigh eᵗ form h = %g: birkhoff2 %.3e, rk4 %.3e, midpoint in z %.3e\n", h, birkhoff2, rk4,
+                midpoint);
+    EXPECT_LE(birkhoff2, kMemberSymplecticityTolerance) << "h = " << h;
     EXPECT_GE(rk4, kViolationFactor * kSymplecticityTolerance) << "h = " << h;
     EXPECT_GE(midpoint, kViolationFactor * kSymplecticityTolerance) << "h = " << h;
   }
