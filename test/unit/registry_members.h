@@ -1,6 +1,6 @@
 // The registry's members as gtest type lists (integrator_members.h), for the typed suites that run
-// over every member's generic stepper: integrator_contract_test, k_symplectic_test,
-// chaplygin_sleigh_test. A new member of the registry is in every one of them without a change here.
+// over every member's generic stepper: integrator_contract_test and k_symplectic_test. A new member
+// of the registry is in each of them without a change here.
 // Header-only: every test/unit/*.cpp is its own executable.
 #pragma once
 

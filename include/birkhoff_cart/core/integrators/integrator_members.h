@@ -4,9 +4,10 @@
 // row builder (src/core/integrators/integrator_registry.cpp): its name(), kOrder, kSymmetric, its
 // kind (member_kind), the step controls it takes and whether it evaluates its stages together.
 //
-// The typed tests instantiate from IntegratorMemberTypes (integrator_contract_test,
-// k_symplectic_test, chaplygin_sleigh_test), and integrator_contract_test checks that its members
-// are the registry's, in the registry's order.
+// The typed tests instantiate from IntegratorMemberTypes (integrator_contract_test and
+// k_symplectic_test, on the test systems, the cart and the example system of
+// examples/chaplygin_sleigh.h), and integrator_contract_test checks that its members are the
+// registry's, in the registry's order.
 //
 // A stepper type S of a member provides (the generic stepper interface, docs/integrators.md):
 //   static const char* name();             the member's name (integrator.name, --integrator)
