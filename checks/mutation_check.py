@@ -171,6 +171,22 @@ MUTATIONS = [
         [("accuracy_guard_test", "*")],
     ),
     Mutation(
+        "effect_coefficient_range",
+        "the effect table lets rolling resistance's speed_epsilon be 0 (tanh(v/0): NaN forces from rest)",
+        "src/core/effects/effect_library.cpp",
+        '{"speed_epsilon", Range::kPositive, "m/s", 0.05}',
+        '{"speed_epsilon", Range::kNonNegative, "m/s", 0.05}',
+        [("scene_test", "*")],
+    ),
+    Mutation(
+        "sleigh_blade_reaction_sign",
+        "the example system's blade reaction turns the sleigh the wrong way (J ω̇ = +m a v ω)",
+        "include/birkhoff_cart/core/examples/chaplygin_sleigh.h",
+        "return Eigen::Matrix<S, 2, 1>(m * a * (p2 / j) * (p2 / j), -a * (p1 / j) * p2);",
+        "return Eigen::Matrix<S, 2, 1>(m * a * (p2 / j) * (p2 / j), a * (p1 / j) * p2);",
+        [("chaplygin_sleigh_test", "*"), ("integrator_contract_test", "*Sleigh*")],
+    ),
+    Mutation(
         "cmd_vel_timeout_ignored",
         "cmd_vel_controller never notices that cmd_vel fell silent (the cart keeps driving)",
         "src/core/node_logic/cmd_vel_controller.cpp",

@@ -4,9 +4,10 @@
 # environment:
 #   1. cart_simulate --version, and a 1 s run of the installed free_coast scene (exit 0, 101 rows),
 #      without sourcing anything (the executables find the package's libraries by their RPATH);
-#   2. with only <prefix>/setup.bash sourced: rospack finds the package in the prefix, and
-#      `roslaunch birkhoff_cart sim.launch` runs 2 s of scene time (fast, recorded) on a private
-#      master and cart_sim ends with "finished".
+#   2. with only <prefix>/setup.bash sourced: rospack finds the package in the prefix, the Python
+#      module birkhoff_cart.simulator imports from the prefix and runs 1 s of the installed free_coast
+#      scene on the prefix's core library, and `roslaunch birkhoff_cart sim.launch` runs 2 s of scene
+#      time (fast, recorded) on a private master and cart_sim ends with "finished".
 # About 30 s on a built workspace. Prints "N passed, N failed" and exits non-zero on a failure.
 #
 # Usage: checks/test_install.sh [--no-build]
@@ -68,6 +69,16 @@ check "rospack finds the package in the prefix" "${clean_env[@]}" bash -c '
 check "installed message type birkhoff_cart/IntegrationError" "${clean_env[@]}" bash -c '
   source "$1/setup.bash" && rosmsg show birkhoff_cart/IntegrationError | grep -q .' _ "$prefix"
 
+check "the Python module runs the installed free_coast scene (prefix sourced), on the prefix's core" "${clean_env[@]}" bash -c '
+  source "$1/setup.bash" && cd "$2" && /usr/bin/python3 -c "
+import os, sys
+from birkhoff_cart import simulator
+assert simulator.__file__.startswith(sys.argv[1]), simulator.__file__
+scene = simulator.load_scene(os.path.join(sys.argv[1], \"share/birkhoff_cart/config/scenes/free_coast.yaml\"), {\"duration\": 1.0})
+assert simulator.Simulation(scene).run()[0] == 1.0
+maps = open(\"/proc/self/maps\").read()
+assert os.path.join(sys.argv[1], \"lib/libbirkhoff_cart_core.so\") in maps, \"core not from the prefix\"
+" "$1"' _ "$prefix" "$destdir"
 port="$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("", 0)); print(s.getsockname()[1])')"
 check "roslaunch birkhoff_cart sim.launch, 2 s of scene time, from the prefix" "${clean_env[@]}" bash -c '
   source "$1/setup.bash" && export ROS_MASTER_URI="http://localhost:$2" &&

@@ -35,6 +35,8 @@ packages=(
   python3-matplotlib python3-numpy
   # the study runner (scripts/study): Dask distributed, its local cluster and the row tables
   python3-distributed python3-dask python3-pandas python3-yaml
+  # the Python module birkhoff_cart.simulator (docs/python.md) and its tests
+  pybind11-dev python3-pybind11 python3-numpy python3-pytest
 )
 missing=()
 for package in "${packages[@]}"; do

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 #include "birkhoff_cart/core/cart_model.h"
@@ -256,10 +257,11 @@ Scene read_scene(const SceneReader& reader, const YAML::Node& root, const std::s
 SceneError::SceneError(const std::string& file, const std::string& key, const std::string& problem)
     : std::runtime_error(one_line("scene " + file + ": key '" + key + "': " + problem)), file_(file), key_(key) {}
 
-Scene load_scene(const std::string& path) {
-  const SceneReader reader(path);
-  std::ifstream stream(path);
-  if (!stream) reader.fail("(file)", "cannot be opened for reading");
+namespace {
+
+/// Parses `stream` as YAML and reads the scene, naming `source` in every SceneError.
+Scene parse_scene(std::istream& stream, const std::string& source) {
+  const SceneReader reader(source);
   YAML::Node root;
   try {
     root = YAML::Load(stream);
@@ -268,12 +270,25 @@ Scene load_scene(const std::string& path) {
                                 std::to_string(error.mark.column + 1) + ": " + error.msg);
   }
   try {
-    return read_scene(reader, root, path);
+    return read_scene(reader, root, source);
   } catch (const SceneError&) {
     throw;
   } catch (const YAML::Exception& error) {
     reader.fail("(document)", one_line(error.what()));
   }
+}
+
+}  // namespace
+
+Scene load_scene(const std::string& path) {
+  std::ifstream stream(path);
+  if (!stream) SceneReader(path).fail("(file)", "cannot be opened for reading");
+  return parse_scene(stream, path);
+}
+
+Scene load_scene_text(const std::string& text, const std::string& source) {
+  std::istringstream stream(text);
+  return parse_scene(stream, source);
 }
 
 }  // namespace birkhoff_cart

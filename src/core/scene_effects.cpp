@@ -1,4 +1,5 @@
-// The `effects` section of a scene file: effect name → its parameters (docs/scenes.md "effects").
+// The `effects` section of a scene file: effect name → its parameters (docs/scenes.md "effects"), as
+// the effect table (effect_library.h) names them, with each coefficient in its row's range.
 #include <map>
 
 #include "birkhoff_cart/core/effect_library.h"
@@ -79,17 +80,19 @@ std::vector<EffectSpec> read_effects(const SceneReader& reader, const YAML::Node
     spec.name = entry.first.Scalar();
     const std::string key = SceneReader::join("effects", spec.name);
     const YAML::Node& node = entry.second;
-    const std::vector<std::string>& coefficient_names = effect_coefficient_names(spec.name);
-    if (coefficient_names.empty()) {
+    const EffectEntry& row = effect_entry(spec.name);  // known: require_map allowed only the table's names
+    if (row.takes_profile()) {
       spec.profile = read_profile(reader, node, key);
     } else {
+      const std::vector<std::string> coefficient_names = coefficient_keys(row);
       if (!node.IsMap()) reader.fail(key, "must be a map of coefficients (" + join_names(coefficient_names) + ")");
       std::vector<std::string> allowed = coefficient_names;
       allowed.push_back("enabled");
       reader.require_map(node, key, allowed);
-      for (const auto& name : coefficient_names) {
-        const Range range = name == "speed_epsilon" ? Range::kPositive : Range::kNonNegative;
-        spec.coefficients[name] = reader.required_number(node, key, name, range);
+      // Each coefficient checked here, once: in the range its row of the effect table states.
+      for (const EffectCoefficient& coefficient : row.coefficients) {
+        const Range range = coefficient.range == CoefficientRange::kPositive ? Range::kPositive : Range::kNonNegative;
+        spec.coefficients[coefficient.key] = reader.required_number(node, key, coefficient.key, range);
       }
     }
     // `enabled: false` keeps the parameters in the file but leaves the effect out of the scene.

@@ -23,6 +23,7 @@ constexpr double kEquationTolerance = 1e-12;  // relative residual of ż [-]
 constexpr double kConversionTolerance = 1e-14;  // relative round trip [-]
 
 using birkhoff_cart_test::all_effect_specs;
+using birkhoff_cart_test::typical_effect_spec;
 
 class CartBirkhoffianTest : public ::testing::Test {
  protected:
@@ -100,7 +101,8 @@ TEST_F(CartBirkhoffianTest, MomentumRatesAreThoseOfTheIndependentModel) {
   // itself, where nothing builds it in; ṗ1 checks the sign and size of Λ_nh + Q.
   constexpr double kFullModelTolerance = 1e-6;  // relative to the largest momentum rate [-]
   const full_model::FullCoordinateModel full(model.parameters());
-  const EffectSet torques_only = build_effects({all_effect_specs()[0], all_effect_specs()[1]}, model);
+  const EffectSpec drive = typical_effect_spec("drive_torque");
+  const EffectSet torques_only = build_effects({typical_effect_spec("steering_torque"), drive}, model);
   CartAutonomousBirkhoffian autonomous(model, torques_only);
   CartPaperBirkhoffian paper(model, torques_only);
   for (const CartState& state : states) {
@@ -112,7 +114,7 @@ TEST_F(CartBirkhoffianTest, MomentumRatesAreThoseOfTheIndependentModel) {
     const Vector2<double> load = torques_only.evaluate(input).force;  // Q [N, N·m]
     full_model::AppliedLoads loads;
     loads.steering_torque = load(1);                                                        // τ = Q2
-    loads.drive_torque = all_effect_specs()[1].profile.value;                               // T [N·m]
+    loads.drive_torque = drive.profile.value;                                               // T [N·m] (constant)
     const Eigen::Vector2d full_rate =
         full.reduced_momentum_rate(q, qd, full_model::FullCoordinateModel::applied_force(loads));
     const double scale = 1.0 + full_rate.cwiseAbs().maxCoeff();

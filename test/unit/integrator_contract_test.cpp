@@ -1,23 +1,25 @@
-// The contract every integrator of the registry keeps (birkhoff2, birkhoff4, rk2, rk4, dopri5,
-// midpoint): observed order by step halving on a system with an exact solution and on the cart,
-// determinism, invariants of the free cart, time symmetry of the symmetric ones, the finite-value
-// guard and misuse errors. One typed suite over the generic steppers (Drake / Boost.Odeint style).
+// The contract every integrator of the registry keeps: observed order by step halving on a system
+// with an exact solution and on the cart, determinism, invariants of the free cart, time symmetry of
+// the symmetric ones, the finite-value guard and misuse errors. One typed suite over the generic
+// steppers of the registry's members (integrator_members.h; Drake / Boost.Odeint style), on the test
+// systems, the cart and the example system (the Chaplygin sleigh: order against its closed form,
+// energy over a long run, reversal), and the check that its members are the registry's.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "birkhoff_cart/core/cart_birkhoffian.h"
 #include "birkhoff_cart/core/effect_library.h"
-#include "birkhoff_cart/core/integrators/birkhoff_symplectic.h"
+#include "birkhoff_cart/core/examples/chaplygin_sleigh.h"
 #include "birkhoff_cart/core/integrators/cart_stepper.h"
-#include "birkhoff_cart/core/integrators/dopri5.h"
-#include "birkhoff_cart/core/integrators/implicit_midpoint.h"
-#include "birkhoff_cart/core/integrators/runge_kutta.h"
+#include "birkhoff_cart/core/integrators/integrator_members.h"
 #include "birkhoff_cart/core/scene.h"
+#include "registry_members.h"
 #include "test_systems.h"
 
 namespace birkhoff_cart {
@@ -32,38 +34,9 @@ Scene load(const std::string& name) {
   return load_scene(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/" + name + ".yaml");
 }
 
-/// The generic stepper of each registry name, with the settings the registry would give it.
+/// dopri5 and any other member that steps for a local error tolerance instead of at h alone.
 template <class Stepper>
-Stepper make_generic();
-template <>
-BirkhoffSymplectic2 make_generic() { return BirkhoffSymplectic2(NewtonSettings{}); }
-template <>
-BirkhoffSymplectic4 make_generic() { return BirkhoffSymplectic4(NewtonSettings{}); }
-template <>
-GaussCollocation<2> make_generic() { return GaussCollocation<2>(NewtonSettings{}); }
-template <>
-GaussCollocation<3> make_generic() { return GaussCollocation<3>(NewtonSettings{}); }
-template <>
-GaussCollocation<4> make_generic() { return GaussCollocation<4>(NewtonSettings{}); }
-template <>
-BirkhoffComposition<SuzukiFiveWeights> make_generic() { return BirkhoffComposition<SuzukiFiveWeights>(NewtonSettings{}); }
-template <>
-BirkhoffComposition<KahanLiSixWeights> make_generic() { return BirkhoffComposition<KahanLiSixWeights>(NewtonSettings{}); }
-template <>
-BirkhoffComposition<KahanLiEightWeights> make_generic() {
-  return BirkhoffComposition<KahanLiEightWeights>(NewtonSettings{});
-}
-template <>
-HeunRungeKutta2 make_generic() { return HeunRungeKutta2(); }
-template <>
-ClassicalRungeKutta4 make_generic() { return ClassicalRungeKutta4(); }
-template <>
-DormandPrince5 make_generic() { return DormandPrince5(1e-10); }
-template <>
-ImplicitMidpoint make_generic() { return ImplicitMidpoint(NewtonSettings{}); }
-
-template <class Stepper>
-constexpr bool kAdaptive = std::is_same<Stepper, DormandPrince5>::value;
+constexpr bool kAdaptive = member_kind<Stepper>() == IntegratorKind::kAdaptive;
 
 /// Observed order against nominal: within ±0.3 up to order 4. From order 6 on, the free cart's
 /// energy error and the forced cart's state error still fall faster than h^p over the step range
@@ -155,21 +128,11 @@ IntegratorSettings settings_for(const std::string& name, BirkhoffianForm form = 
 template <class Stepper>
 class IntegratorContract : public ::testing::Test {
  protected:
-  const Stepper stepper_ = make_generic<Stepper>();
+  const Stepper stepper_ = birkhoff_cart_test::default_stepper<Stepper>();  ///< built as the registry builds it
 };
 
-using AllSteppers =
-    ::testing::Types<BirkhoffSymplectic2, BirkhoffSymplectic4, GaussCollocation<2>, GaussCollocation<3>,
-                     GaussCollocation<4>, BirkhoffComposition<SuzukiFiveWeights>,
-                     BirkhoffComposition<KahanLiSixWeights>, BirkhoffComposition<KahanLiEightWeights>,
-                     HeunRungeKutta2, ClassicalRungeKutta4, DormandPrince5, ImplicitMidpoint>;
-struct StepperNames {
-  template <class Stepper>
-  static std::string GetName(int) {
-    return Stepper::name();
-  }
-};
-TYPED_TEST_SUITE(IntegratorContract, AllSteppers, StepperNames);
+// Every member of the registry (integrator_members.h), under its own name.
+TYPED_TEST_SUITE(IntegratorContract, birkhoff_cart_test::RegistrySteppers, birkhoff_cart_test::StepperNames);
 
 // The registry makes it under its own name. Its order() and symmetric() flags are checked against
 // measured behaviour (observed order, reversibility) in registry_properties_test.cpp: compared here
@@ -190,10 +153,10 @@ TYPED_TEST(IntegratorContract, ObservedOrderOnDampedOscillator) {
     // dopri5: the error decreases with the tolerance (same simulator step h = 0.1 s).
     std::vector<double> errors;
     for (double tolerance : {1e-6, 1e-8, 1e-10, 1e-12}) {
-      errors.push_back(damped_oscillator_error(DormandPrince5(tolerance), kDuration, 20));
+      errors.push_back(damped_oscillator_error(TypeParam(tolerance), kDuration, 20));
     }
     for (std::size_t i = 1; i < errors.size(); ++i) {
-      std::printf("dopri5 damped oscillator: tolerance 1e-%zu error %.3e\n", 4 + 2 * i, errors[i]);
+      std::printf("%s damped oscillator: tolerance 1e-%zu error %.3e\n", TypeParam::name(), 4 + 2 * i, errors[i]);
       EXPECT_LT(errors[i], errors[i - 1]);
     }
     EXPECT_LT(errors.back(), 1e-10);
@@ -221,11 +184,11 @@ TYPED_TEST(IntegratorContract, ObservedOrderOnForcedCartInBothRepresentations) {
     if constexpr (kAdaptive<TypeParam>) {
       std::vector<double> errors;
       for (double tolerance : {1e-6, 1e-8, 1e-10}) {
-        IntegratorSettings settings = settings_for("dopri5", form);
+        IntegratorSettings settings = settings_for(TypeParam::name(), form);
         settings.tolerance = tolerance;
         errors.push_back(state_difference(run_cart(scene, settings, 0.05, 20), reference));
       }
-      std::printf("dopri5 cart (%s): errors %.3e %.3e %.3e for tolerances 1e-6, 1e-8, 1e-10\n", to_string(form),
+      std::printf("%s cart (%s): errors %.3e %.3e %.3e for tolerances 1e-6, 1e-8, 1e-10\n", TypeParam::name(), to_string(form),
                   errors[0], errors[1], errors[2]);
       EXPECT_LT(errors[1], errors[0]);
       EXPECT_LT(errors[2], errors[1]);
@@ -282,14 +245,14 @@ TYPED_TEST(IntegratorContract, FreeCartInvariants) {
   if constexpr (kAdaptive<TypeParam>) {
     std::vector<double> energy_errors;
     for (double tolerance : {1e-6, 1e-8, 1e-10}) {
-      IntegratorSettings settings = settings_for("dopri5");
+      IntegratorSettings settings = settings_for(TypeParam::name());
       settings.tolerance = tolerance;
       double energy_error, p2_error;
       run(settings, 40, energy_error, p2_error);
       energy_errors.push_back(energy_error);
       EXPECT_LE(p2_error, kLinearInvariantTolerance);
     }
-    std::printf("dopri5 free cart: max |dT*/T*| %.3e %.3e %.3e for tolerances 1e-6, 1e-8, 1e-10\n",
+    std::printf("%s free cart: max |dT*/T*| %.3e %.3e %.3e for tolerances 1e-6, 1e-8, 1e-10\n", TypeParam::name(),
                 energy_errors[0], energy_errors[1], energy_errors[2]);
     EXPECT_LT(energy_errors[1], energy_errors[0]);
     EXPECT_LT(energy_errors[2], energy_errors[1]);
@@ -393,11 +356,125 @@ TYPED_TEST(IntegratorContract, RejectsBadStepSizes) {
   EXPECT_EQ(state.time, scene.initial_state.time);
 }
 
-TEST(IntegratorRegistry, ListsEveryIntegrator) {
-  EXPECT_EQ(integrator_names(),
-            (std::vector<std::string>{"birkhoff2", "birkhoff4", "rk2", "rk4", "dopri5", "midpoint", "birkhoff_gauss4",
-                                      "birkhoff_gauss6", "birkhoff_gauss8", "birkhoff4_suzuki", "birkhoff6_kahan_li",
-                                      "birkhoff8_kahan_li"}));
+// ---------------------------------------------------------------------------------------------
+// The example system (include/birkhoff_cart/core/examples/chaplygin_sleigh.h): the same contract on
+// a nonholonomic system the members were not written for, through their generic step() alone.
+
+constexpr double kSleighDuration = 3.0;       // order runs [s]
+constexpr double kSleighLongRun = 2000.0;     // energy run [s]
+constexpr double kSleighLongStep = 0.05;      // its step [s]
+constexpr double kSleighEnergyRoundOff = 1e-12;  // |E − E₀| / E₀ kept by the symmetric members [-]
+
+/// Backing up at 0.4 m/s while turning at 2 rad/s: through v = 0 into the turn and out (S.3).
+Eigen::Vector4d sleigh_start(const ChaplyginSleigh& sleigh) { return sleigh.state(0.1, 0.3, -0.4, 2.0); }
+
+/// n steps of duration/n from (z₀, y = 0) at t = 0; the largest relative energy error on the way.
+template <class Stepper>
+Eigen::Vector4d run_sleigh(const Stepper& stepper, const ChaplyginSleigh& sleigh, const Eigen::Vector4d& z0,
+                           double duration, int steps, double* energy_error = nullptr) {
+  Eigen::Vector4d z = z0;
+  Eigen::Vector2d y = Eigen::Vector2d::Zero();
+  StepStatistics statistics;
+  const double energy0 = sleigh.hamiltonian(z0);
+  const double h = duration / steps;
+  double largest = 0.0;
+  for (int k = 0; k < steps; ++k) {
+    stepper.step(sleigh, z, y, k * h, h, statistics);
+    largest = std::max(largest, std::abs(sleigh.hamiltonian(z) - energy0) / energy0);
+  }
+  if (energy_error) *energy_error = largest;
+  return z;
+}
+
+int sleigh_base_steps(int order) { return order == 2 ? 100 : order == 4 ? 30 : order == 6 ? 12 : 8; }
+
+TYPED_TEST(IntegratorContract, ObservedOrderOnTheChaplyginSleigh) {
+  // Against the closed form (S.3) over 3 s, in the autonomous form (γ = 0) and the paper's eᵗ form
+  // (γ = 1, a time-dependent chart).
+  for (double gamma : {0.0, 1.0}) {
+    ChaplyginSleighParameters parameters;
+    parameters.conformal_rate = gamma;
+    const ChaplyginSleigh sleigh(parameters);
+    const Eigen::Vector4d z0 = sleigh_start(sleigh);
+    const Eigen::Vector4d exact = ChaplyginSleighMotion(sleigh, z0, 0.0).at(kSleighDuration, sleigh);
+    auto error_of = [&](const TypeParam& stepper, int steps) {
+      return (run_sleigh(stepper, sleigh, z0, kSleighDuration, steps) - exact).cwiseAbs().maxCoeff();
+    };
+    if constexpr (kAdaptive<TypeParam>) {
+      const double e1 = error_of(TypeParam(1e-6), 30), e2 = error_of(TypeParam(1e-8), 30), e3 = error_of(TypeParam(1e-10), 30);
+      std::printf("%s sleigh (gamma %g): errors %.3e %.3e %.3e for tolerances 1e-6, 1e-8, 1e-10\n", TypeParam::name(),
+                  gamma, e1, e2, e3);
+      EXPECT_LT(e2, e1);
+      EXPECT_LT(e3, e2);
+    } else {
+      const int steps = sleigh_base_steps(TypeParam::kOrder);
+      const double e1 = error_of(this->stepper_, steps), e2 = error_of(this->stepper_, 2 * steps),
+                   e3 = error_of(this->stepper_, 4 * steps);
+      const double order12 = std::log2(e1 / e2), order23 = std::log2(e2 / e3);
+      std::printf("%s sleigh (gamma %g): errors %.3e %.3e %.3e, observed orders %.3f %.3f\n", TypeParam::name(), gamma,
+                  e1, e2, e3, order12, order23);
+      expect_order(order12, TypeParam::kOrder, "sleigh");
+      expect_order(order23, TypeParam::kOrder, "sleigh");
+    }
+  }
+}
+
+TYPED_TEST(IntegratorContract, ChaplyginSleighEnergyOverALongRun) {
+  // 2000 s at h = 0.05 s (40 000 steps) through the turn and the glide: the energy, a quadratic
+  // invariant, is kept to round-off by the symmetric members (Gauss collocation and the midpoint
+  // compositions keep every quadratic invariant) and stays bounded, not drifting, over the run; the
+  // others miss it by their local errors.
+  const ChaplyginSleigh sleigh;
+  const Eigen::Vector4d z0 = sleigh_start(sleigh);
+  const int steps = static_cast<int>(kSleighLongRun / kSleighLongStep);
+  double energy_error = 0.0;
+  run_sleigh(this->stepper_, sleigh, z0, kSleighLongRun, steps, &energy_error);
+  std::printf("%s sleigh over %g s: max |dE/E| %.3e\n", TypeParam::name(), kSleighLongRun, energy_error);
+  if (TypeParam::kSymmetric) {
+    EXPECT_LE(energy_error, kSleighEnergyRoundOff);
+  } else {
+    EXPECT_GT(energy_error, 1e3 * std::numeric_limits<double>::epsilon());
+    EXPECT_LE(energy_error, 1e-3);
+  }
+}
+
+TYPED_TEST(IntegratorContract, ChaplyginSleighIsReversedOnlyBySymmetricMembers) {
+  // The sleigh is reversible under R: p ↦ −p (positions kept): ż = f(z) with R f(R z) = −f(z).
+  // A symmetric member's map is R-reversible: R Φⁿ R Φⁿ = id to round-off; another misses by
+  // O(n h^{p+1}) (dopri5's miss is at its tolerance: not informative).
+  const ChaplyginSleigh sleigh;
+  const Eigen::Vector4d z0 = sleigh_start(sleigh);
+  const auto flip = [](Eigen::Vector4d z) {
+    z(kSleighForwardMomentum) = -z(kSleighForwardMomentum);
+    z(kSleighAngularMomentum) = -z(kSleighAngularMomentum);
+    return z;
+  };
+  constexpr int kSteps = 20;
+  const Eigen::Vector4d back = flip(run_sleigh(this->stepper_, sleigh, flip(run_sleigh(this->stepper_, sleigh, z0, 2.0, kSteps)),
+                                               2.0, kSteps));
+  const double defect = (back - z0).cwiseAbs().maxCoeff() / std::max(1.0, z0.cwiseAbs().maxCoeff());
+  std::printf("%s sleigh: reversal defect %.3e\n", TypeParam::name(), defect);
+  if (TypeParam::kSymmetric) {
+    EXPECT_LE(defect, kSymmetryTolerance);
+  } else if (!kAdaptive<TypeParam>) {
+    EXPECT_GT(defect, 1e3 * kSymmetryTolerance);
+  }
+}
+
+TEST(IntegratorRegistry, TheTypedSuitesRunOverEveryMember) {
+  // The typed suites (this one and k_symplectic_test) take their members from
+  // integrator_members.h: they are the registry's, in its order, each named once.
+  const std::vector<std::string> tested = birkhoff_cart_test::stepper_names<IntegratorMemberTypes>();
+  EXPECT_EQ(tested, integrator_names());
+  EXPECT_EQ(std::set<std::string>(tested.begin(), tested.end()).size(), tested.size());
+  EXPECT_GE(tested.size(), 12u);
+  // The Birkhoffian ones (K(z,t)-symplectic tests) are exactly the rows of a Birkhoffian kind.
+  std::vector<std::string> birkhoffian_rows;
+  for (const IntegratorEntry& row : integrator_registry()) {
+    if (is_birkhoffian(row.kind)) birkhoffian_rows.emplace_back(row.name);
+  }
+  EXPECT_EQ(birkhoff_cart_test::stepper_names<birkhoff_cart_test::BirkhoffianMemberTypes>(), birkhoffian_rows);
+  EXPECT_EQ(birkhoffian_rows.size(), 8u);
 }
 
 TEST(IntegratorRegistry, UnknownNameListsTheKnownOnes) {

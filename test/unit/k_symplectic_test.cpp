@@ -1,8 +1,10 @@
 // The defining property of the generalized symplectic schemes (docs/birkhoffian.md §7, (B.14)):
 // for Λ = 0 the Jacobian M = ∂z⁽ᵏ⁺¹⁾/∂z⁽ᵏ⁾ of one step, taken by forward-mode AD through the whole
-// step (Newton included), satisfies Mᵀ K(z⁽ᵏ⁺¹⁾, tₖ₊₁) M = K(z⁽ᵏ⁾, tₖ). birkhoff2/birkhoff4 pass on
-// every system; rk4 and birkhoff2 in the wrong (identity) chart fail by orders of magnitude, so the
-// check can fail. Also: symmetry (+h then −h) and the α-mapping identity (B.13).
+// step (Newton included), satisfies Mᵀ K(z⁽ᵏ⁺¹⁾, tₖ₊₁) M = K(z⁽ᵏ⁾, tₖ). Every Birkhoffian member of
+// the registry (integrator_members.h) passes on every system (the test oscillators, the cart's two
+// forms and the example system, the Chaplygin sleigh, in its two); rk4, the midpoint rule in z and
+// birkhoff2 in the wrong (identity) chart fail by orders of magnitude, so the check can fail. Also:
+// symmetry (+h then −h) and the α-mapping identity (B.13).
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -16,9 +18,11 @@
 #include "birkhoff_cart/core/cart_birkhoffian.h"
 #include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/effects.h"
+#include "birkhoff_cart/core/examples/chaplygin_sleigh.h"
 #include "birkhoff_cart/core/integrators/birkhoff_symplectic.h"
 #include "birkhoff_cart/core/integrators/implicit_midpoint.h"
 #include "birkhoff_cart/core/integrators/runge_kutta.h"
+#include "registry_members.h"
 #include "test_systems.h"
 
 namespace birkhoff_cart {
@@ -29,6 +33,7 @@ using testing::CubicDampedOscillator;
 using testing::DampedOscillator;
 
 constexpr double kSymplecticityTolerance = 1e-12;  // ‖MᵀK⁺M − K‖_F / ‖K‖_F [-]
+constexpr double kMemberSymplecticityTolerance = 1e-13;  // the same, for every Birkhoffian member [-]
 constexpr double kViolationFactor = 1e4;           // a non-K-symplectic map misses by ≥ this × tolerance [-]
 constexpr double kSymmetryTolerance = 1e-12;       // ‖z(+h, −h) − z‖∞ / max(1, ‖z‖∞) [-]
 
@@ -125,6 +130,17 @@ struct CartFixture {
   }
 };
 
+/// The Chaplygin sleigh (examples/chaplygin_sleigh.h) in the form with conformal rate γ [1/s]
+/// (0: autonomous, 1: the paper's eᵗ form), with or without the blade's reaction Λ.
+ChaplyginSleigh sleigh_form(double gamma, bool with_blade) {
+  ChaplyginSleighParameters parameters;
+  parameters.conformal_rate = gamma;
+  ChaplyginSleigh sleigh(parameters);
+  sleigh.set_non_birkhoffian_force_enabled(with_blade);
+  return sleigh;
+}
+ChaplyginSleigh sleigh_birkhoffian_part(double gamma) { return sleigh_form(gamma, false); }
+
 const double kStepSizes[] = {1e-3, 1e-2, 0.1};  // h [s]
 // A non-K-symplectic one-step map misses by O(h^{p+1}) per step (rk4: ~1e-16 at h = 1e-3, i.e.
 // round-off): the violation checks use steps where that is far above round-off.
@@ -164,52 +180,55 @@ void expect_k_symplectic_on_all_systems(const Stepper& stepper, double tolerance
       worst = std::max({worst, da, db});
     }
   }
+  // The example system: the Chaplygin sleigh's Birkhoffian part in the autonomous and the eᵗ form.
+  for (double gamma : {0.0, 1.0}) {
+    const ChaplyginSleigh sleigh = sleigh_birkhoffian_part(gamma);
+    for (double h : kStepSizes) {
+      for (int trial = 0; trial < 3; ++trial) {
+        const Eigen::Vector4d z = sleigh.state(uniform(random), uniform(random), uniform(random), uniform(random));
+        const double d = symplecticity_defect(stepper, sleigh, z, uniform(random), h, statistics);
+        EXPECT_LE(d, tolerance) << "sleigh gamma = " << gamma << " h = " << h;
+        worst = std::max(worst, d);
+      }
+    }
+  }
   std::printf("[ measured ] %s: worst K-symplecticity defect %.3e; Newton iterations %llu over %llu rhs evaluations\n",
               Stepper::name(), worst, static_cast<unsigned long long>(statistics.newton_iterations_total),
               static_cast<unsigned long long>(statistics.rhs_evaluations));
 }
 
-TEST(KSymplecticity, Birkhoff2PreservesTheStructureOnEverySystem) {
-  expect_k_symplectic_on_all_systems(BirkhoffSymplectic2{});
+/// The typed suites below run over the Birkhoffian members of the registry (integrator_members.h),
+/// each built as the registry builds it.
+template <class Stepper>
+class BirkhoffianMember : public ::testing::Test {
+ protected:
+  const Stepper stepper_ = birkhoff_cart_test::default_stepper<Stepper>();
+};
+TYPED_TEST_SUITE(BirkhoffianMember, birkhoff_cart_test::BirkhoffianSteppers, birkhoff_cart_test::StepperNames);
+
+TYPED_TEST(BirkhoffianMember, PreservesTheStructureOnEverySystem) {
+  // A defect ≤ 1e-13 on the Λ = 0 systems: the oscillators with constant, time-dependent and
+  // nonlinear charts, and the cart's Birkhoffian part in both forms.
+  expect_k_symplectic_on_all_systems(this->stepper_, kMemberSymplecticityTolerance);
 }
 
-TEST(KSymplecticity, Birkhoff4PreservesTheStructureOnEverySystem) {
-  expect_k_symplectic_on_all_systems(BirkhoffSymplectic4{});
-}
-
-TEST(KSymplecticity, GaussMembersPreserveTheStructureOnEverySystem) {
-  // A defect ≤ 1e-13 on the Λ = 0 systems.
-  expect_k_symplectic_on_all_systems(GaussCollocation<2>{}, 1e-13);
-  expect_k_symplectic_on_all_systems(GaussCollocation<3>{}, 1e-13);
-  expect_k_symplectic_on_all_systems(GaussCollocation<4>{}, 1e-13);
-}
-
-TEST(KSymplecticity, HigherCompositionsPreserveTheStructureOnEverySystem) {
-  expect_k_symplectic_on_all_systems(BirkhoffComposition<SuzukiFiveWeights>{}, 1e-13);
-  expect_k_symplectic_on_all_systems(BirkhoffComposition<KahanLiSixWeights>{}, 1e-13);
-  expect_k_symplectic_on_all_systems(BirkhoffComposition<KahanLiEightWeights>{}, 1e-13);
-}
-
-TEST(Symmetry, GaussMembersAndCompositionsReturnToTheStart) {
+TYPED_TEST(BirkhoffianMember, ForwardThenBackwardStepReturnsToTheStart) {
   const CartFixture cart;
   CartAutonomousBirkhoffian full_b(cart.model, cart.no_effects);
   CartPaperBirkhoffian full_a(cart.model, cart.no_effects);
   const Eigen::Vector2d z(0.8, -0.6);
   for (double h : kStepSizes) {
-    auto check = [&](const auto& stepper) {
-      EXPECT_LE(symmetry_defect(stepper, DampedOscillator{}, z, 0.3, h), kSymmetryTolerance) << stepper.name();
-      EXPECT_LE(symmetry_defect(stepper, CubicChartOscillator{}, z, 0.3, h), kSymmetryTolerance) << stepper.name();
-      for (const Eigen::Vector4d& zc : cart.states) {
-        EXPECT_LE(symmetry_defect(stepper, full_a, zc, 7.0, h), kSymmetryTolerance) << stepper.name();
-        EXPECT_LE(symmetry_defect(stepper, full_b, zc, 7.0, h), kSymmetryTolerance) << stepper.name();
-      }
-    };
-    check(GaussCollocation<2>{});
-    check(GaussCollocation<3>{});
-    check(GaussCollocation<4>{});
-    check(BirkhoffComposition<SuzukiFiveWeights>{});
-    check(BirkhoffComposition<KahanLiSixWeights>{});
-    check(BirkhoffComposition<KahanLiEightWeights>{});
+    EXPECT_LE(symmetry_defect(this->stepper_, DampedOscillator{}, z, 0.3, h), kSymmetryTolerance) << h;
+    EXPECT_LE(symmetry_defect(this->stepper_, CubicChartOscillator{}, z, 0.3, h), kSymmetryTolerance) << h;
+    for (const Eigen::Vector4d& zc : cart.states) {
+      EXPECT_LE(symmetry_defect(this->stepper_, full_a, zc, 7.0, h), kSymmetryTolerance) << h;
+      EXPECT_LE(symmetry_defect(this->stepper_, full_b, zc, 7.0, h), kSymmetryTolerance) << h;
+    }
+    for (double gamma : {0.0, 1.0}) {  // the sleigh with its blade, both forms
+      const ChaplyginSleigh sleigh = sleigh_form(gamma, true);
+      EXPECT_LE(symmetry_defect(this->stepper_, sleigh, sleigh.state(0.2, 0.4, -0.5, 1.7), 0.8, h), kSymmetryTolerance)
+          << "sleigh gamma = " << gamma << " h = " << h;
+    }
   }
 }
 
@@ -249,6 +268,25 @@ TEST(KSymplecticity, NonlinearTimeDependentChartSeparatesBirkhoffFromRk4AndMidpo
   }
 }
 
+TEST(KSymplecticity, TheSleighsPaperFormSeparatesBirkhoffFromRk4AndMidpointInZ) {
+  // The sleigh's eᵗ form (K = eᵗ K₀, chart w = (q, eᵗ p)): the Birkhoffian members pass
+  // (BirkhoffianMember.PreservesTheStructureOnEverySystem); rk4 and the midpoint rule in z, which do
+  // not step in the chart, fail it by orders of magnitude.
+  StepStatistics statistics;
+  const ChaplyginSleigh sleigh = sleigh_birkhoffian_part(1.0);
+  const Eigen::Vector4d z = sleigh.state(0.3, -0.2, 0.8, -1.1);
+  for (double h : kViolationStepSizes) {
+    const double birkhoff2 = symplecticity_defect(BirkhoffSymplectic2{}, sleigh, z, 0.4, h, statistics);
+    const double rk4 = symplecticity_defect(ClassicalRungeKutta4{}, sleigh, z, 0.4, h, statistics);
+    const double midpoint = symplecticity_defect(ImplicitMidpoint{}, sleigh, z, 0.4, h, statistics);
+    std::printf("[ measured ] sleigh eᵗ form h = %g: birkhoff2 %.3e, rk4 %.3e, midpoint in z %.3e\n", h, birkhoff2, rk4,
+                midpoint);
+    EXPECT_LE(birkhoff2, kMemberSymplecticityTolerance) << "h = " << h;
+    EXPECT_GE(rk4, kViolationFactor * kSymplecticityTolerance) << "h = " << h;
+    EXPECT_GE(midpoint, kViolationFactor * kSymplecticityTolerance) << "h = " << h;
+  }
+}
+
 TEST(KSymplecticity, Birkhoff2InTheWrongChartViolatesIt) {
   // Identity chart = implicit midpoint in z: fine for constant K, wrong for K = e^{γt}K₀ and for
   // K = (1 + p²)K₀. The cart (b) has K = K₀, where the identity chart *is* a Darboux chart.
@@ -271,24 +309,9 @@ TEST(KSymplecticity, Birkhoff2InTheWrongChartViolatesIt) {
   }
 }
 
-TEST(Symmetry, ForwardThenBackwardStepReturnsToTheStart) {
-  const CartFixture cart;
-  CartAutonomousBirkhoffian full_b(cart.model, cart.no_effects);
-  CartPaperBirkhoffian full_a(cart.model, cart.no_effects);
-  for (double h : kStepSizes) {
-    const Eigen::Vector2d z(0.8, -0.6);
-    EXPECT_LE(symmetry_defect(BirkhoffSymplectic2{}, DampedOscillator{}, z, 0.3, h), kSymmetryTolerance);
-    EXPECT_LE(symmetry_defect(BirkhoffSymplectic4{}, DampedOscillator{}, z, 0.3, h), kSymmetryTolerance);
-    EXPECT_LE(symmetry_defect(BirkhoffSymplectic2{}, CubicChartOscillator{}, z, 0.3, h), kSymmetryTolerance);
-    EXPECT_LE(symmetry_defect(BirkhoffSymplectic4{}, CubicChartOscillator{}, z, 0.3, h), kSymmetryTolerance);
-    for (const Eigen::Vector4d& zc : cart.states) {
-      EXPECT_LE(symmetry_defect(BirkhoffSymplectic2{}, full_a, zc, 7.0, h), kSymmetryTolerance);
-      EXPECT_LE(symmetry_defect(BirkhoffSymplectic4{}, full_a, zc, 7.0, h), kSymmetryTolerance);
-      EXPECT_LE(symmetry_defect(BirkhoffSymplectic2{}, full_b, zc, 7.0, h), kSymmetryTolerance);
-      EXPECT_LE(symmetry_defect(BirkhoffSymplectic4{}, full_b, zc, 7.0, h), kSymmetryTolerance);
-    }
-  }
-  // Control: rk4 is not symmetric, its defect is far above round-off at h = 0.1.
+TEST(Symmetry, Rk4DoesNotReturnToTheStart) {
+  // The control of ForwardThenBackwardStepReturnsToTheStart: rk4 is not symmetric, its defect is far
+  // above round-off at h = 0.1.
   const double rk4_defect = symmetry_defect(ClassicalRungeKutta4{}, DampedOscillator{}, Eigen::Vector2d(0.8, -0.6), 0.3,
                                             0.1);
   std::printf("[ measured ] rk4 +h/−h defect at h = 0.1: %.3e\n", rk4_defect);

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -370,6 +371,48 @@ TEST_F(SceneFiles, MalformedScenesNameTheFileAndTheKey) {
       EXPECT_EQ(message.find('\n'), std::string::npos) << malformed.label;
     }
   }
+}
+
+TEST_F(SceneFiles, EveryEffectCoefficientIsCheckedInItsRowsRange) {
+  // The reader checks each coefficient of every row of the effect table (effect_library.h) once, in
+  // the row's range: the typical value loads; a negative, a non-finite and (kPositive) a zero one are
+  // refused naming effects.<effect>.<key>; a torque effect takes no coefficient.
+  int checked = 0;
+  for (const EffectEntry& row : effect_table()) {
+    if (row.takes_profile()) {
+      const std::string text = std::string(kMinimalScene) + "effects:\n  " + row.name + ": {profile: constant, value: 1.0, coefficient: 1.0}\n";
+      EXPECT_THROW(load_scene(write(std::string(row.name) + "_with_coefficient", text)), SceneError) << row.name;
+      continue;
+    }
+    auto scene_with = [&](const std::string& key, const std::string& value) {
+      std::string map;
+      for (const EffectCoefficient& coefficient : row.coefficients) {
+        std::ostringstream text;
+        text.precision(17);
+        text << coefficient.typical;
+        map += std::string(map.empty() ? "" : ", ") + coefficient.key + ": " + (coefficient.key == key ? value : text.str());
+      }
+      return std::string(kMinimalScene) + "effects:\n  " + row.name + ": {" + map + "}\n";
+    };
+    const Scene typical = load_scene(write(std::string(row.name) + "_typical", scene_with("", "")));
+    ASSERT_EQ(typical.effects.size(), 1u);
+    EXPECT_EQ(typical.effects[0].coefficients.size(), row.coefficients.size());
+    for (const EffectCoefficient& coefficient : row.coefficients) {
+      std::vector<std::string> refused = {"-1.0", ".nan", ".inf"};
+      if (coefficient.range == CoefficientRange::kPositive) refused.push_back("0.0");
+      for (const std::string& value : refused) {
+        const std::string label = std::string(row.name) + "_" + coefficient.key + "_" + value.substr(value.find_first_not_of("-."));
+        try {
+          load_scene(write(label, scene_with(coefficient.key, value)));
+          ADD_FAILURE() << label << ": accepted";
+        } catch (const SceneError& error) {
+          EXPECT_EQ(error.key(), "effects." + std::string(row.name) + "." + coefficient.key) << error.what();
+        }
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GE(checked, 16);
 }
 
 TEST_F(SceneFiles, NonexistentFileNamesTheFile) {

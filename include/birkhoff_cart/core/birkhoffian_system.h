@@ -4,27 +4,39 @@
 //
 // with Birkhoff functions R, Birkhoffian B, structure matrix K and an explicit non-Birkhoffian
 // generalized force Λ (nonholonomic terms, applied loads). Passive coordinates y (reconstructed
-// coordinates, accumulated work) follow ẏ = g(z, t) and never feed back.
+// coordinates, accumulated work) follow ẏ = g(z, y, t) and never feed back into z.
 //
-// A system type `System` models this concept (static polymorphism, as Boost.Odeint's systems) by
-// providing, with Vector<S> = Eigen::Matrix<S, kDimension, 1>:
+// A system type `System` models this concept (static polymorphism, as Boost.Odeint's systems); every
+// member of the integrator registry integrates any model through its generic step(system, z, y, t,
+// h, statistics) (integrators/integrator_members.h). How to bring your own, shown on the Chaplygin
+// sleigh (examples/chaplygin_sleigh.h): docs/integrators.md, "Bring your own system".
 //
-//   static constexpr int kDimension;          // 2n
-//   static constexpr int kPassiveDimension;   // dim y (may be 0)
-//   template <class S> Vector<S>  birkhoff_functions(const Vector<S>& z, const S& t) const;   // R
-//   template <class S> S          birkhoffian(const Vector<S>& z, const S& t) const;          // B
-//   template <class S> Matrix<S>  structure_matrix(const Vector<S>& z, const S& t) const;     // K, analytic
-//   (optional) template <class S> Matrix<S> structure_matrix_inverse(z, t) const;            // K⁻¹, analytic
-//   template <class S> Vector<S>  birkhoffian_gradient(const Vector<S>& z, const S& t) const; // ∇B, analytic
-//   template <class S> Vector<S>  birkhoff_functions_time_derivative(const Vector<S>& z, const S& t) const; // ∂R/∂t
-//   template <class S> Vector<S>  non_birkhoffian_force(const Vector<S>& z, const S& t) const; // Λ (zero
-//                                                                   // when non_birkhoffian_force_enabled() is false)
-//   bool non_birkhoffian_force_enabled() const;
+// Units. t is in s. z has the system's own units, coordinate by coordinate ([z_i]; for a mechanical
+// system z = (q, p): m or rad, then kg·m/s or kg·m²/s); R_i has units of J·s / [z_i] (R·dz is an
+// action), B is in J, K_ij in J·s / ([z_i][z_j]), ∇B_i, (∂R/∂t)_i and Λ_i in J / [z_i]; the Darboux
+// chart's w = (Q, P) has Q·P in J·s; y has its own units ([y_k]), g in [y_k]/s.
+//
+// Required, with Vector<S> = Eigen::Matrix<S, kDimension, 1>, Matrix<S> its square, PassiveVector<S>
+// = Eigen::Matrix<S, kPassiveDimension, 1>, and S any scalar: double or an AD jet (autodiff.h; the
+// K-symplecticity tests differentiate whole steps):
+//
+//   static constexpr int kDimension;          // 2n, the size of z
+//   static constexpr int kPassiveDimension;   // the size of y (may be 0)
+//   bool non_birkhoffian_force_enabled() const;  // false: Λ = 0 (the Birkhoffian part alone)
+//   template <class S> Vector<S> birkhoff_functions(const Vector<S>& z, const S& t) const;    // R(z, t)
+//   template <class S> S         birkhoffian(const Vector<S>& z, const S& t) const;           // B(z, t) [J]
+//   template <class S> Matrix<S> structure_matrix(const Vector<S>& z, const S& t) const;      // K(z, t), analytic
+//   template <class S> Vector<S> birkhoffian_gradient(const Vector<S>& z, const S& t) const;  // ∇B = ∂B/∂z, analytic
+//   template <class S> Vector<S> birkhoff_functions_time_derivative(const Vector<S>& z, const S& t) const;  // ∂R/∂t
+//   template <class S> Vector<S> non_birkhoffian_force(const Vector<S>& z, const S& t) const; // Λ (zero when
+//                                                                      // non_birkhoffian_force_enabled() is false)
 //   // A Darboux chart w = D(z, t) = (Q, P) with D_zᵀ K₀ D_z = K(z, t), K₀ = [[0, −I], [I, 0]], in
-//   // which the Birkhoffian part is Hamiltonian; the generalized symplectic schemes work in it.
-//   template <class S> Vector<S>  to_darboux(const Vector<S>& z, const S& t) const;
-//   template <class S> Vector<S>  from_darboux(const Vector<S>& w, const S& t) const;
-//   template <class S> Vector<S>  darboux_rates(const Vector<S>& w, const S& t) const;        // ẇ, analytic
+//   // which the Birkhoffian part is Hamiltonian; the Birkhoffian members (Gauss collocation and its
+//   // compositions) step in it, which makes them K(z,t)-symplectic where Λ = 0.
+//   template <class S> Vector<S> to_darboux(const Vector<S>& z, const S& t) const;            // w = D(z, t)
+//   template <class S> Vector<S> from_darboux(const Vector<S>& w, const S& t) const;          // z = D⁻¹(w, t)
+//   template <class S> Vector<S> darboux_rates(const Vector<S>& w, const S& t) const;         // ẇ = D_z ż + ∂_t D,
+//                                                                      // analytic, Λ included when enabled
 //   template <class S> PassiveVector<S> passive_rates(const Vector<S>& z, const S& t) const;  // g(z, t)
 //   // or, when the passive rates read passive coordinates themselves (the cart: ẋ = ω1 cos(θ + χ)
 //   // needs the heading θ, a passive coordinate), instead
@@ -33,8 +45,42 @@
 //   // Integrators call the free function passive_coordinate_rates(system, z, y, t), which picks the
 //   // member that exists. y never feeds back into z.
 //
+// Optional, detected by the members when present (each changes the cost or the round-off, never
+// the method; a wrong one changes the trajectory, so test it: chaplygin_sleigh_test compares a
+// system with its hooks against the same system without them):
+//
+//   template <class S> Matrix<S> structure_matrix_inverse(const Vector<S>& z, const S& t) const;
+//       K⁻¹(z, t) in closed form, for the solved rates ż = K⁻¹(∇B + ∂R/∂t + Λ) (birkhoffian_rates:
+//       the explicit peers, the midpoint rule); without it K is LU-factored at every call.
+//   static constexpr unsigned kCyclicMask;
+//       Bit i set: no component of ẇ reads w_i (the cart's arc length π1; the sleigh's π1 and θ), so
+//       column i of J = ∂ẇ/∂w is zero. The stage solve takes those coordinates out of its Newton
+//       block (kronecker_newton.h; it checks the column and keeps them in when it is not zero) and
+//       their changes do not vote in its stop rule. Default 0 (none).
+//   static constexpr int kPassiveCouplingDepth;
+//       d ≥ 0: g reads y only through passive coordinates whose own rates depend on z alone, nested
+//       d deep (d = 0: g does not read y at all; d = 1 for the cart: ẋ reads θ, and θ̇ reads z), so
+//       d + 1 sweeps of the passive quadrature are exact. Default: sweeps until the stages settle
+//       (at most 50, then StepError).
+//   static constexpr bool kDarbouxChartIsLinear;
+//       true: D(z, t) is linear in z (at each t), so the compensated-summation remainders map through
+//       the chart; compensated summation (IntegratorSettings::compensated_summation) needs it.
+//       Default false: no compensation.
+//   Matrix<double> darboux_jacobian(const Vector<double>& w, double t) const;
+//       J = ∂ẇ/∂w at (w, t) in closed form [1/s in the chart's units], for the simplified-Newton
+//       matrices of the stage solve; default: forward-mode AD of darboux_rates (one jet evaluation).
+//   template <std::size_t s> void darboux_rates_stages(const std::array<Vector<double>, s>& w,
+//       const std::array<double, s>& t, std::array<Vector<double>, s>& rates) const;
+//       ẇ at the s stages of a collocation step at once (the cart: one vector sin/cos for all stages,
+//       vector_math.h); must equal darboux_rates point by point to round-off. Used from two stages on.
+//   template <class S> PassiveVector<S> passive_coupling_rates(const Vector<S>& z, const S& t) const;
+//       With kPassiveCouplingDepth = d ≥ 1: the rates of just the passive coordinates g reads, each a
+//       function of z alone (the cart: θ̇), other entries zero, equal to passive_rates' entries bit
+//       for bit; the first d passive sweeps evaluate only these.
+//
 // The analytic members (K, ∇B, ∂R/∂t, ẇ) are what the integrators use; tests check each against
-// automatic differentiation of R and B (test/unit/birkhoffian_system_test.cpp).
+// automatic differentiation of R and B (test/unit/structure_checks.h, used by
+// birkhoffian_system_test for the test systems and the cart and by chaplygin_sleigh_test).
 #pragma once
 
 #include <Eigen/Core>

@@ -62,4 +62,9 @@ struct Scene {
 /// Loads and validates a scene. Throws SceneError naming the file and the key.
 Scene load_scene(const std::string& path);
 
+/// The same from the YAML text of a scene document; `source` stands for the file in the scene's
+/// name (its stem), source_path and every SceneError (the Python module: a dict, or a file with
+/// overrides).
+Scene load_scene_text(const std::string& text, const std::string& source);
+
 }  // namespace birkhoff_cart

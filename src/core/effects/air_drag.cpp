@@ -2,15 +2,10 @@
 #include "birkhoff_cart/core/effects/air_drag.h"
 
 #include <cmath>
-#include <stdexcept>
 
 namespace birkhoff_cart {
 
-AirDrag::AirDrag(double coefficient) : coefficient_(coefficient) {
-  if (!std::isfinite(coefficient) || coefficient < 0.0) {
-    throw std::invalid_argument("effect 'air_drag': 'coefficient' must be finite and >= 0");
-  }
-}
+AirDrag::AirDrag(double coefficient) : coefficient_(coefficient) {}
 
 const std::string& AirDrag::name() const {
   static const std::string kName = "air_drag";

@@ -1,14 +1,14 @@
-// build_effects: from the scene's EffectSpecs to the EffectSet of the enabled effects.
+// The effect table (one row per effect) and build_effects: from the scene's EffectSpecs to the
+// EffectSet of the enabled effects.
 #include "birkhoff_cart/core/effect_library.h"
 
-#include <cmath>
-#include <map>
-#include <optional>
+#include <algorithm>
 #include <memory>
+#include <optional>
 #include <set>
-#include <sstream>
 #include <stdexcept>
 
+#include "birkhoff_cart/core/closest_name.h"
 #include "birkhoff_cart/core/effects/air_drag.h"
 #include "birkhoff_cart/core/effects/drive_torque.h"
 #include "birkhoff_cart/core/effects/rolling_resistance.h"
@@ -20,40 +20,63 @@
 namespace birkhoff_cart {
 namespace {
 
-std::string join(const std::vector<std::string>& names) {
-  std::string joined;
-  for (const auto& name : names) joined += (joined.empty() ? "" : ", ") + name;
-  return joined;
-}
-
 [[noreturn]] void fail(const std::string& effect_name, const std::string& problem) {
   throw std::invalid_argument("effect '" + effect_name + "': " + problem);
 }
 
-/// The coefficient `key` of `spec`: present, finite, ≥ 0 (> 0 when `strictly_positive`).
-double coefficient(const EffectSpec& spec, const std::string& key, bool strictly_positive) {
-  const auto found = spec.coefficients.find(key);
-  if (found == spec.coefficients.end()) fail(spec.name, "missing coefficient '" + key + "'");
-  const double value = found->second;
-  if (!std::isfinite(value) || value < 0.0 || (strictly_positive && value == 0.0)) {
-    std::ostringstream problem;
-    problem << "coefficient '" << key << "' must be finite and " << (strictly_positive ? "> 0" : ">= 0")
-            << ", got " << value;
-    fail(spec.name, problem.str());
-  }
-  return value;
-}
-
-void reject_unknown_coefficients(const EffectSpec& spec) {
-  const std::vector<std::string>& known = effect_coefficient_names(spec.name);
+/// Every coefficient of the row present in `spec`, and no other.
+void require_row_coefficients(const EffectEntry& entry, const EffectSpec& spec) {
+  const std::vector<std::string> known = coefficient_keys(entry);
   for (const auto& [key, value] : spec.coefficients) {
-    (void)value;
-    bool is_known = false;
-    for (const auto& name : known) is_known = is_known || name == key;
-    if (!is_known) {
-      fail(spec.name, "unknown coefficient '" + key + "' (known: " + (known.empty() ? "none" : join(known)) + ")");
+    static_cast<void>(value);
+    if (std::find(known.begin(), known.end(), key) == known.end()) {
+      fail(spec.name, "unknown coefficient '" + key + "' (known: " + (known.empty() ? "none" : name_list(known)) + ")");
     }
   }
+  for (const std::string& key : known) {
+    if (spec.coefficients.count(key) == 0) fail(spec.name, "missing coefficient '" + key + "'");
+  }
+}
+
+TorqueProfile constant_profile(double value) {
+  TorqueProfile profile;
+  profile.kind = TorqueProfile::Kind::kConstant;
+  profile.value = value;  // [N·m]
+  return profile;
+}
+
+TorqueProfile cosine_profile(double amplitude, double frequency) {
+  TorqueProfile profile;
+  profile.kind = TorqueProfile::Kind::kCosine;
+  profile.amplitude = amplitude;  // [N·m]
+  profile.frequency = frequency;  // [Hz]
+  return profile;
+}
+
+/// The effect table. Each row: name, equation of docs/derivation.md, coefficients (key, range,
+/// unit, typical value), torque channel, typical profile (torque effects), factory.
+std::vector<EffectEntry> make_effect_table() {
+  using Range = CoefficientRange;
+  using P = const EffectParameters&;
+  using Made = std::unique_ptr<Effect>;
+  return {
+      {"steering_torque", "(4.1)", {}, TorqueChannel::kSteering, cosine_profile(3.0, 0.4),
+       [](P p) -> Made { return std::make_unique<SteeringTorque>(*p.torque); }},
+      {"drive_torque", "(4.2)", {}, TorqueChannel::kDrive, constant_profile(25.0),
+       [](P p) -> Made { return std::make_unique<DriveTorque>(*p.torque, p.model.parameters().rear_wheel_radius); }},
+      {"rolling_resistance", "(4.3)",
+       {{"coefficient", Range::kNonNegative, "-", 0.015}, {"speed_epsilon", Range::kPositive, "m/s", 0.05}},
+       TorqueChannel::kNone, {},
+       [](P p) -> Made {
+         return std::make_unique<RollingResistance>(p.model, p.coefficient("coefficient"), p.coefficient("speed_epsilon"));
+       }},
+      {"air_drag", "(4.4)", {{"coefficient", Range::kNonNegative, "kg/m", 0.4}}, TorqueChannel::kNone, {},
+       [](P p) -> Made { return std::make_unique<AirDrag>(p.coefficient("coefficient")); }},
+      {"steering_damping", "(4.5)", {{"coefficient", Range::kNonNegative, "N·m·s/rad", 2.0}}, TorqueChannel::kNone, {},
+       [](P p) -> Made { return std::make_unique<SteeringDamping>(p.coefficient("coefficient")); }},
+      {"steering_stiffness", "(4.6)", {{"coefficient", Range::kNonNegative, "N·m/rad", 15.0}}, TorqueChannel::kNone, {},
+       [](P p) -> Made { return std::make_unique<SteeringStiffness>(p.coefficient("coefficient")); }},
+  };
 }
 
 /// A torque source; for `command` profiles also a fresh CommandInput, stored in `command`.
@@ -115,26 +138,43 @@ const EffectSpec* find_spec(const std::vector<EffectSpec>& specs, const std::str
 
 }  // namespace
 
+double EffectParameters::coefficient(const std::string& key) const {
+  const auto found = spec.coefficients.find(key);
+  if (found == spec.coefficients.end()) fail(spec.name, "missing coefficient '" + key + "'");
+  return found->second;
+}
+
+const std::vector<EffectEntry>& effect_table() {
+  static const std::vector<EffectEntry> kTable = make_effect_table();
+  return kTable;
+}
+
+const EffectEntry* find_effect(const std::string& name) {
+  for (const EffectEntry& entry : effect_table()) {
+    if (name == entry.name) return &entry;
+  }
+  return nullptr;
+}
+
+const EffectEntry& effect_entry(const std::string& name) {
+  const EffectEntry* entry = find_effect(name);
+  if (entry == nullptr) throw std::invalid_argument(unknown_name_message("effect", name, effect_names()));
+  return *entry;
+}
+
 const std::vector<std::string>& effect_names() {
-  static const std::vector<std::string> kNames = {"steering_torque",  "drive_torque",     "rolling_resistance",
-                                                  "air_drag",         "steering_damping", "steering_stiffness"};
+  static const std::vector<std::string> kNames = [] {
+    std::vector<std::string> names;
+    for (const EffectEntry& entry : effect_table()) names.emplace_back(entry.name);
+    return names;
+  }();
   return kNames;
 }
 
-const std::vector<std::string>& effect_coefficient_names(const std::string& effect_name) {
-  static const std::map<std::string, std::vector<std::string>> kCoefficients = {
-      {"steering_torque", {}},
-      {"drive_torque", {}},
-      {"rolling_resistance", {"coefficient", "speed_epsilon"}},
-      {"air_drag", {"coefficient"}},
-      {"steering_damping", {"coefficient"}},
-      {"steering_stiffness", {"coefficient"}},
-  };
-  const auto found = kCoefficients.find(effect_name);
-  if (found == kCoefficients.end()) {
-    throw std::invalid_argument("unknown effect '" + effect_name + "' (known: " + join(effect_names()) + ")");
-  }
-  return found->second;
+std::vector<std::string> coefficient_keys(const EffectEntry& entry) {
+  std::vector<std::string> keys;
+  for (const EffectCoefficient& coefficient : entry.coefficients) keys.emplace_back(coefficient.key);
+  return keys;
 }
 
 EffectSet build_effects(const std::vector<EffectSpec>& specs, const CartModel& model) {
@@ -156,27 +196,16 @@ EffectSet build_effects(const std::vector<EffectSpec>& specs, const CartModel& m
       actuator_for("drive_actuator", actuators.drive, find_spec(specs, "drive_torque"), start_time);
   std::set<std::string> seen;
   for (const EffectSpec& spec : specs) {
-    reject_unknown_coefficients(spec);  // also rejects an unknown effect name
+    const EffectEntry& entry = effect_entry(spec.name);
+    require_row_coefficients(entry, spec);
     if (!seen.insert(spec.name).second) fail(spec.name, "named twice");
-    if (spec.name == "steering_torque") {
-      std::shared_ptr<CommandInput> command;
-      effects.add(std::make_unique<SteeringTorque>(torque_source(spec, command, steering_actuator)));
-      if (command) effects.set_steering_command_input(command);
-    } else if (spec.name == "drive_torque") {
-      std::shared_ptr<CommandInput> command;
-      effects.add(std::make_unique<DriveTorque>(torque_source(spec, command, drive_actuator),
-                                                model.parameters().rear_wheel_radius));
-      if (command) effects.set_drive_command_input(command);
-    } else if (spec.name == "rolling_resistance") {
-      effects.add(std::make_unique<RollingResistance>(model, coefficient(spec, "coefficient", false),
-                                                      coefficient(spec, "speed_epsilon", true)));
-    } else if (spec.name == "air_drag") {
-      effects.add(std::make_unique<AirDrag>(coefficient(spec, "coefficient", false)));
-    } else if (spec.name == "steering_damping") {
-      effects.add(std::make_unique<SteeringDamping>(coefficient(spec, "coefficient", false)));
-    } else if (spec.name == "steering_stiffness") {
-      effects.add(std::make_unique<SteeringStiffness>(coefficient(spec, "coefficient", false)));
-    }
+    std::shared_ptr<CommandInput> command;
+    std::optional<TorqueSource> torque;
+    if (entry.torque_channel == TorqueChannel::kSteering) torque = torque_source(spec, command, steering_actuator);
+    if (entry.torque_channel == TorqueChannel::kDrive) torque = torque_source(spec, command, drive_actuator);
+    effects.add(entry.make(EffectParameters{model, spec, torque ? &*torque : nullptr}));
+    if (command && entry.torque_channel == TorqueChannel::kSteering) effects.set_steering_command_input(command);
+    if (command && entry.torque_channel == TorqueChannel::kDrive) effects.set_drive_command_input(command);
   }
   effects.set_steering_actuator(steering_actuator);
   effects.set_drive_actuator(drive_actuator);

@@ -2,18 +2,11 @@
 #include "birkhoff_cart/core/effects/rolling_resistance.h"
 
 #include <cmath>
-#include <stdexcept>
 
 namespace birkhoff_cart {
 
 RollingResistance::RollingResistance(const CartModel& model, double coefficient, double speed_epsilon)
     : model_(model), coefficient_(coefficient), speed_epsilon_(speed_epsilon) {
-  if (!std::isfinite(coefficient) || coefficient < 0.0) {
-    throw std::invalid_argument("effect 'rolling_resistance': 'coefficient' must be finite and >= 0");
-  }
-  if (!std::isfinite(speed_epsilon) || speed_epsilon <= 0.0) {
-    throw std::invalid_argument("effect 'rolling_resistance': 'speed_epsilon' must be finite and > 0 m/s");
-  }
   const CartParameters& p = model_.parameters();
   const double rear_load = (0.5 * p.rear_body_mass + p.rear_wheel_mass) * p.gravity;   // [N]
   const double front_load = (0.5 * p.front_axle_mass + p.front_wheel_mass) * p.gravity;  // [N]

@@ -2,15 +2,10 @@
 #include "birkhoff_cart/core/effects/steering_damping.h"
 
 #include <cmath>
-#include <stdexcept>
 
 namespace birkhoff_cart {
 
-SteeringDamping::SteeringDamping(double coefficient) : coefficient_(coefficient) {
-  if (!std::isfinite(coefficient) || coefficient < 0.0) {
-    throw std::invalid_argument("effect 'steering_damping': 'coefficient' must be finite and >= 0");
-  }
-}
+SteeringDamping::SteeringDamping(double coefficient) : coefficient_(coefficient) {}
 
 const std::string& SteeringDamping::name() const {
   static const std::string kName = "steering_damping";

@@ -2,15 +2,10 @@
 #include "birkhoff_cart/core/effects/steering_stiffness.h"
 
 #include <cmath>
-#include <stdexcept>
 
 namespace birkhoff_cart {
 
-SteeringStiffness::SteeringStiffness(double coefficient) : coefficient_(coefficient) {
-  if (!std::isfinite(coefficient) || coefficient < 0.0) {
-    throw std::invalid_argument("effect 'steering_stiffness': 'coefficient' must be finite and >= 0");
-  }
-}
+SteeringStiffness::SteeringStiffness(double coefficient) : coefficient_(coefficient) {}
 
 const std::string& SteeringStiffness::name() const {
   static const std::string kName = "steering_stiffness";

@@ -40,14 +40,16 @@ class AdaptiveCartStepperAdapter final : public CartStepper {
   using Carried = CarriedCartState<System, Memory>;
   using Control = AdaptiveStepControl<Stepper, System, Carried>;
   using Output = CarriedCartState<System, NoStepMemory>;  ///< what was handed out (no stage memory)
-  /// Hermite points: the interpolant's order 2m matches the member's (m = max(2, p/2)).
-  static constexpr int kDensePoints = Stepper::kOrder / 2 > 2 ? Stepper::kOrder / 2 : 2;
+  /// Hermite points: m + 1, m = max(2, p/2), so that the interpolant one point shorter, of the
+  /// member's own order 2m, estimates its error (grid_dense_output.h).
+  static constexpr int kDensePoints = (Stepper::kOrder / 2 > 2 ? Stepper::kOrder / 2 : 2) + 1;
 
  public:
   AdaptiveCartStepperAdapter(const Stepper& stepper, const IntegratorSettings& settings, const CartModel& model,
                              const EffectSet& effects)
       : system_(model, effects), effects_(&effects), name_(Stepper::name()),
-        control_(stepper, control_settings(settings)), instants_(effects) {}
+        control_(stepper, control_settings(settings)), position_tolerance_(settings.position_tolerance),
+        instants_(effects) {}
 
   const std::string& name() const override { return name_; }
   int order() const override { return Stepper::kOrder; }
@@ -146,9 +148,22 @@ class AdaptiveCartStepperAdapter final : public CartStepper {
       output_.point = grid.point;
       output_.steering_turns = grid.steering_turns;
       output_.heading_turns = grid.heading_turns;
-    } else {
-      dense_.at(system_, target, output_, statistics);
+    } else if (!(dense_.at(system_, target, output_, statistics) <= position_tolerance_)) {
+      side_step(target, statistics);  // where the dense output's own estimate exceeds the tolerance
     }
+  }
+
+  /// The state at `target` by one step of the member from the grid point before it: exact to the
+  /// member's order where the dense output's estimate says it is not.
+  void side_step(double target, StepStatistics& statistics) {
+    output_.point = control_.previous();
+    output_.steering_turns = control_.previous_steering_turns();
+    output_.heading_turns = control_.previous_heading_turns();
+    Memory memory;  // no stage history: an explicit start
+    const double start = control_.previous_time();
+    system_.begin_step(start);
+    control_.stepper().advance_compensated(system_, output_.point, memory, start, target - start, statistics);
+    output_.reduce_angles();
   }
 
   /// A grid point's CartState at time t [s] (its angles as carried: the balance does not read turns).
@@ -170,6 +185,7 @@ class AdaptiveCartStepperAdapter final : public CartStepper {
   const EffectSet* effects_;
   std::string name_;
   Control control_;
+  double position_tolerance_;  ///< [m]
   GridDenseOutput<System, kDensePoints> dense_;
   Output output_;
   GridObserver observer_;

@@ -5,6 +5,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 
 #include "birkhoff_cart/core/birkhoffian_system.h"
 #include "birkhoff_cart/core/diagnostics.h"
@@ -14,7 +16,8 @@
 
 namespace birkhoff_cart {
 
-/// The last `Points` grid points of a run and their Hermite interpolant in (z, y).
+/// The last `Points` grid points of a run and their Hermite interpolant in (z, y): of degree
+/// 2·Points − 1, its position error estimated against the one through Points − 1.
 template <class System, int Points>
 class GridDenseOutput {
  public:
@@ -62,9 +65,11 @@ class GridDenseOutput {
   }
 
   /// The carried point at t [s] (inside the newest step) in `out`, with the newest point's turns.
-  /// The rates of the points that lack them are evaluated here, once each.
+  /// The rates of the points that lack them are evaluated here, once each. Returns an estimate of
+  /// the interpolant's position error [m] (against the interpolant one point shorter: a conservative
+  /// one; NaN with a single point).
   template <class Carried>
-  void at(System& system, double t, Carried& out, StepStatistics& statistics) {
+  double at(System& system, double t, Carried& out, StepStatistics& statistics) {
     for (int j = 0; j < history_.size(); ++j) {
       if (history_.has_rate(j)) continue;
       const Joint& x = history_.value(j);
@@ -77,13 +82,15 @@ class GridDenseOutput {
       ++statistics.passive_evaluations;
       history_.set_rate(j, rate);
     }
-    const Joint x = history_.at(t);
+    Joint difference;
+    const Joint x = history_.at(t, &difference);
     out.point.z = x.template head<System::kDimension>();
     out.point.y = x.template tail<System::kPassiveDimension>();
     out.point.z_remainder.setZero();
     out.point.y_remainder.setZero();
     out.steering_turns = steering_turns_;
     out.heading_turns = heading_turns_;
+    return std::hypot(difference(System::kDimension + kXIndex), difference(System::kDimension + kYIndex));
   }
 
  private:

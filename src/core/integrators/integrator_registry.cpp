@@ -1,57 +1,28 @@
-// The integrator registry (integrator_registry.h): the table of the members, and the two factories
-// that turn a member's generic stepper into a CartStepper, at fixed steps or under the reversible
-// step control, in the Birkhoffian form the settings name.
+// The integrator registry (integrator_registry.h): one row per member of integrator_members.h, read
+// from its stepper type, with the factories that turn the member's generic stepper into a
+// CartStepper — at fixed steps, under the reversible or under the adaptive step control — in the
+// Birkhoffian form the settings name.
 #include "birkhoff_cart/core/integrators/integrator_registry.h"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <type_traits>
 #include <utility>
 
 #include "birkhoff_cart/core/cart_birkhoffian.h"
 #include "birkhoff_cart/core/closest_name.h"
-#include "birkhoff_cart/core/integrators/birkhoff_symplectic.h"
-#include "birkhoff_cart/core/integrators/dopri5.h"
-#include "birkhoff_cart/core/integrators/implicit_midpoint.h"
-#include "birkhoff_cart/core/integrators/runge_kutta.h"
-#include "cart_stepper_adapter.h"
+#include "birkhoff_cart/core/integrators/carried_state.h"
+#include "birkhoff_cart/core/integrators/integrator_members.h"
 #include "adaptive_cart_stepper.h"
+#include "cart_stepper_adapter.h"
 #include "dopri5_cart_stepper.h"
 #include "reversible_cart_stepper.h"
 
 namespace birkhoff_cart {
 namespace {
-
-/// A stepper with its own local error tolerance (dopri5) reads the settings' `tolerance`.
-template <class Stepper, class = void>
-struct HasTolerance : std::false_type {};
-template <class Stepper>
-struct HasTolerance<Stepper, std::void_t<decltype(std::declval<const Stepper&>().tolerance())>> : std::true_type {};
-
-/// A member's generic stepper, built from the settings it reads: the Birkhoffian members their
-/// stage solve's (collocation) settings, the midpoint rule its Newton settings, an adaptive pair
-/// its tolerance, an explicit method nothing.
-template <class Stepper>
-Stepper configured(const IntegratorSettings& settings) {
-  if constexpr (std::is_constructible_v<Stepper, const CollocationSettings&>) {
-    CollocationSettings collocation;
-    collocation.max_iterations = settings.max_newton_iterations;
-    collocation.compensated = settings.compensated_summation;
-    collocation.estimate_local_error = settings.local_error_estimate;
-    return Stepper(collocation);
-  } else if constexpr (std::is_constructible_v<Stepper, const NewtonSettings&>) {
-    NewtonSettings newton;
-    newton.tolerance = settings.newton_tolerance;
-    newton.max_iterations = settings.max_newton_iterations;
-    return Stepper(newton);
-  } else if constexpr (HasTolerance<Stepper>::value) {
-    return Stepper(settings.tolerance);
-  } else {
-    return Stepper();
-  }
-}
 
 /// The factory of a member at fixed steps of h; dopri5 runs once over the whole run with its own
 /// steps (dopri5_cart_stepper.h; an explicit method takes the same steps in either form).
@@ -61,11 +32,19 @@ std::unique_ptr<CartStepper> fixed_step(const IntegratorSettings& settings, cons
   if constexpr (std::is_same_v<Stepper, DormandPrince5>) {
     return std::make_unique<Dopri5RunCartStepper>(settings.tolerance, model, effects);
   }
-  const Stepper stepper = configured<Stepper>(settings);
+  const Stepper stepper = configured_stepper<Stepper>(settings);
   if (settings.birkhoffian_form == BirkhoffianForm::kPaper) {
     return make_fixed_step_adapter<Stepper, CartPaperBirkhoffian>(stepper, model, effects);
   }
   return make_fixed_step_adapter<Stepper, CartAutonomousBirkhoffian>(stepper, model, effects);
+}
+
+/// The member's stepper with its local error estimate on: the step controls read it.
+template <class Stepper>
+Stepper estimating_stepper(const IntegratorSettings& settings) {
+  IntegratorSettings estimating = settings;
+  estimating.local_error_estimate = true;
+  return configured_stepper<Stepper>(estimating);
 }
 
 /// The factory of a symmetric Birkhoffian member under the reversible step control
@@ -80,21 +59,26 @@ std::unique_ptr<CartStepper> reversible_step(const IntegratorSettings& settings,
         "step_control 'reversible' needs birkhoffian_form 'autonomous': the time transformation steps in the "
         "autonomous chart, and the paper form's chart moves with time");
   }
-  IntegratorSettings estimating = settings;
-  estimating.local_error_estimate = true;
-  const Stepper stepper = configured<Stepper>(estimating);
-  return std::make_unique<ReversibleCartStepperAdapter<Stepper, CartAutonomousBirkhoffian>>(stepper, settings, model,
-                                                                                           effects);
+  return std::make_unique<ReversibleCartStepperAdapter<Stepper, CartAutonomousBirkhoffian>>(
+      estimating_stepper<Stepper>(settings), settings, model, effects);
 }
 
-/// The factory of a Birkhoffian member under the error-per-step control (adaptive_cart_stepper.h):
-/// the control reads the member's own local error estimate, which is therefore always on.
+/// The reversible step control is offered to the symmetric members that carry their own state
+/// between steps (the Birkhoffian ones: carried_state.h); nullptr for the others.
+template <class Stepper>
+constexpr CartStepperFactory reversible_factory() {
+  if constexpr (Stepper::kSymmetric && kCarriesState<Stepper, CartAutonomousBirkhoffian>) {
+    return reversible_step<Stepper>;
+  } else {
+    return nullptr;
+  }
+}
+
+/// The factory of a Birkhoffian member under the error-per-step control (adaptive_cart_stepper.h).
 template <class Stepper>
 std::unique_ptr<CartStepper> adaptive_step(const IntegratorSettings& settings, const CartModel& model,
                                            const EffectSet& effects) {
-  IntegratorSettings estimating = settings;
-  estimating.local_error_estimate = true;
-  const Stepper stepper = configured<Stepper>(estimating);
+  const Stepper stepper = estimating_stepper<Stepper>(settings);
   if (settings.birkhoffian_form == BirkhoffianForm::kPaper) {
     return std::make_unique<AdaptiveCartStepperAdapter<Stepper, CartPaperBirkhoffian>>(stepper, settings, model,
                                                                                       effects);
@@ -120,54 +104,51 @@ std::unique_ptr<CartStepper> adaptive_dopri5(const IntegratorSettings& settings,
   return std::make_unique<Dopri5RunCartStepper>(std::max(per_step, DormandPrince5::kMinTolerance), model, effects);
 }
 
+/// The adaptive step control is offered to the members with their own local error estimate: the
+/// Birkhoffian ones (they carry their state between steps) and dopri5; nullptr for the others.
+template <class Stepper>
+constexpr CartStepperFactory adaptive_factory() {
+  if constexpr (std::is_same_v<Stepper, DormandPrince5>) {
+    return adaptive_dopri5;
+  } else if constexpr (kCarriesState<Stepper, CartAutonomousBirkhoffian>) {
+    return adaptive_step<Stepper>;
+  } else {
+    return nullptr;
+  }
+}
+
 /// Does the member evaluate its stages together (GaussCollocation::kEvaluatesStagesTogether)?
 template <class Stepper, class = void>
 struct StagesTogether : std::false_type {};
 template <class Stepper>
 struct StagesTogether<Stepper, std::void_t<decltype(Stepper::kEvaluatesStagesTogether)>>
     : std::integral_constant<bool, Stepper::kEvaluatesStagesTogether> {};
-template <class Stepper>
-constexpr bool vector_stages = StagesTogether<Stepper>::value;
 
-using Kind = IntegratorKind;
+/// The row of a member: everything but the description read from its stepper type. A new column
+/// (a factory under another step control) is one more line here.
+template <class Stepper>
+IntegratorEntry registry_row(const IntegratorMember<Stepper>& member) {
+  IntegratorEntry row;
+  row.name = Stepper::name();
+  row.order = Stepper::kOrder;
+  row.symmetric = Stepper::kSymmetric;
+  row.kind = member_kind<Stepper>();
+  row.description = member.description;
+  row.make_fixed = fixed_step<Stepper>;
+  row.make_reversible = reversible_factory<Stepper>();
+  row.make_adaptive = adaptive_factory<Stepper>();
+  row.vector_stages = StagesTogether<Stepper>::value;
+  return row;
+}
 
 }  // namespace
 
 const std::vector<IntegratorEntry>& integrator_registry() {
-  // The members, in the registry's order (integrator_names(), the help, the tests' cases): name,
-  // order p, symmetric, kind, description, factory at fixed steps, factory under reversible control,
-  // stages evaluated together (from the stepper's type).
-  // A function's static: built at the first call, whichever static initializer asks first.
-  static const std::vector<IntegratorEntry> kRegistry = {
-      {"birkhoff2", 2, true, Kind::kBirkhoffianCollocation, "Su's scheme: 1-stage Gauss in the chart",
-       fixed_step<GaussCollocation<1>>, reversible_step<GaussCollocation<1>>, adaptive_step<GaussCollocation<1>>, vector_stages<GaussCollocation<1>>},
-      {"birkhoff4", 4, true, Kind::kComposition, "triple jump of birkhoff2",
-       fixed_step<BirkhoffComposition<TripleJumpWeights>>, reversible_step<BirkhoffComposition<TripleJumpWeights>>,
-       adaptive_step<BirkhoffComposition<TripleJumpWeights>>, vector_stages<BirkhoffComposition<TripleJumpWeights>>},
-      {"rk2", 2, false, Kind::kExplicitRungeKutta, "Heun's method", fixed_step<HeunRungeKutta2>, nullptr, nullptr,
-       vector_stages<HeunRungeKutta2>},
-      {"rk4", 4, false, Kind::kExplicitRungeKutta, "classical Runge-Kutta", fixed_step<ClassicalRungeKutta4>, nullptr, nullptr,
-       vector_stages<ClassicalRungeKutta4>},
-      {"dopri5", 5, false, Kind::kAdaptive, "Dormand-Prince 5(4) of Boost.Odeint", fixed_step<DormandPrince5>,
-       nullptr, adaptive_dopri5, vector_stages<DormandPrince5>},
-      {"midpoint", 2, true, Kind::kImplicitMidpoint, "implicit midpoint rule on z", fixed_step<ImplicitMidpoint>,
-       nullptr, nullptr, vector_stages<ImplicitMidpoint>},
-      {"birkhoff_gauss4", 4, true, Kind::kBirkhoffianCollocation, "2-stage Gauss-Legendre in the chart",
-       fixed_step<GaussCollocation<2>>, reversible_step<GaussCollocation<2>>, adaptive_step<GaussCollocation<2>>, vector_stages<GaussCollocation<2>>},
-      {"birkhoff_gauss6", 6, true, Kind::kBirkhoffianCollocation, "3-stage Gauss-Legendre in the chart",
-       fixed_step<GaussCollocation<3>>, reversible_step<GaussCollocation<3>>, adaptive_step<GaussCollocation<3>>, vector_stages<GaussCollocation<3>>},
-      {"birkhoff_gauss8", 8, true, Kind::kBirkhoffianCollocation, "4-stage Gauss-Legendre in the chart",
-       fixed_step<GaussCollocation<4>>, reversible_step<GaussCollocation<4>>, adaptive_step<GaussCollocation<4>>, vector_stages<GaussCollocation<4>>},
-      {"birkhoff4_suzuki", 4, true, Kind::kComposition, "Suzuki's 5 stages of birkhoff2",
-       fixed_step<BirkhoffComposition<SuzukiFiveWeights>>, reversible_step<BirkhoffComposition<SuzukiFiveWeights>>,
-       adaptive_step<BirkhoffComposition<SuzukiFiveWeights>>, vector_stages<BirkhoffComposition<SuzukiFiveWeights>>},
-      {"birkhoff6_kahan_li", 6, true, Kind::kComposition, "Kahan & Li's 9 stages of birkhoff2",
-       fixed_step<BirkhoffComposition<KahanLiSixWeights>>, reversible_step<BirkhoffComposition<KahanLiSixWeights>>,
-       adaptive_step<BirkhoffComposition<KahanLiSixWeights>>, vector_stages<BirkhoffComposition<KahanLiSixWeights>>},
-      {"birkhoff8_kahan_li", 8, true, Kind::kComposition, "Kahan & Li's 17 stages of birkhoff2",
-       fixed_step<BirkhoffComposition<KahanLiEightWeights>>, reversible_step<BirkhoffComposition<KahanLiEightWeights>>,
-       adaptive_step<BirkhoffComposition<KahanLiEightWeights>>, vector_stages<BirkhoffComposition<KahanLiEightWeights>>},
-  };
+  // One row per member of integrator_members.h, in its order. A function's static: built at the
+  // first call, whichever static initializer asks first.
+  static const std::vector<IntegratorEntry> kRegistry = std::apply(
+      [](const auto&... member) { return std::vector<IntegratorEntry>{registry_row(member)...}; },
+      kIntegratorMembers);
   return kRegistry;
 }
 

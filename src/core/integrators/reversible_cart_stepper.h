@@ -61,8 +61,9 @@ class ReversibleCartStepperAdapter final : public CartStepper {
   using Control = ReversibleStepControl<Stepper, System, Grid>;
   using Output = CarriedCartState<System, NoStepMemory>;
   using SideMemory = typename Stepper::template Memory<System>;
-  /// Hermite points: the interpolant's order 2m matches the member's (m = max(2, p/2)).
-  static constexpr int kDensePoints = Stepper::kOrder / 2 > 2 ? Stepper::kOrder / 2 : 2;
+  /// Hermite points: m + 1, m = max(2, p/2), so that the interpolant one point shorter, of the
+  /// member's own order 2m, estimates its error (grid_dense_output.h).
+  static constexpr int kDensePoints = (Stepper::kOrder / 2 > 2 ? Stepper::kOrder / 2 : 2) + 1;
 
  public:
   static constexpr double kFirstTrialStep = 0.25;  ///< ε₀ of the first trial [rad]
@@ -192,10 +193,8 @@ class ReversibleCartStepperAdapter final : public CartStepper {
     const bool land = instants_.exact_at(target);
     if (control_->time() == target) {
       copy_grid_point(control_->grid().point, control_->grid().steering_turns, control_->grid().heading_turns);
-    } else if (land) {
-      side_step(target, statistics);
-    } else {
-      dense_.at(system_, target, output_, statistics);
+    } else if (land || !(dense_.at(system_, target, output_, statistics) <= settings_.position_tolerance)) {
+      side_step(target, statistics);  // exact, or where the dense output's own estimate exceeds the tolerance
     }
   }
 

@@ -73,6 +73,12 @@ class AdaptiveStepControl {
   double proposed_step() const { return proposed_step_; }
   Carried& grid() { return grid_; }
   const Carried& grid() const { return grid_; }
+  const Stepper& stepper() const { return stepper_; }
+  /// The grid point before the last accepted step, and its time [s].
+  const CompensatedPoint<System>& previous() const { return previous_; }
+  double previous_time() const { return previous_time_; }
+  double previous_steering_turns() const { return previous_steering_turns_; }
+  double previous_heading_turns() const { return previous_heading_turns_; }
 
   /// Starts the grid at the carried point of `from` (its point and turns; not its stage history) at
   /// time t [s], with the first step `first_step` [s] (> 0).
@@ -84,6 +90,10 @@ class AdaptiveStepControl {
     grid_.valid = from.valid;
     grid_.memory.clear();
     time_.set(t);
+    previous_ = grid_.point;
+    previous_time_ = t;
+    previous_steering_turns_ = grid_.steering_turns;
+    previous_heading_turns_ = grid_.heading_turns;
     proposed_step_ = first_step;
     last_error_ratio_ = 0.0;
     last_step_ = 0.0;
@@ -139,6 +149,10 @@ class AdaptiveStepControl {
         proposed_step_ = h * factor;
         continue;
       }
+      previous_ = saved_point;
+      previous_steering_turns_ = grid_.steering_turns;
+      previous_heading_turns_ = grid_.heading_turns;
+      previous_time_ = time();
       grid_.reduce_angles();
       if (lands) {
         time_.set(limit);
@@ -223,6 +237,10 @@ class AdaptiveStepControl {
   AdaptiveStepSettings settings_;
   Carried grid_;
   CompensatedTime time_;         ///< tₙ [s]
+  CompensatedPoint<System> previous_;      ///< the point before the last accepted step
+  double previous_time_ = 0.0;             ///< [s]
+  double previous_steering_turns_ = 0.0;   ///< its turns [-]
+  double previous_heading_turns_ = 0.0;
   double proposed_step_ = 0.0;   ///< the next attempt's h [s]
   double last_error_ratio_ = 0.0;  ///< ê/(τh) of the last accepted step [-]
   bool ramping_ = false;           ///< the steps after a start are still growing unhindered

@@ -29,6 +29,7 @@
 #include <cmath>
 
 #include "birkhoff_cart/core/integrators/gauss_collocation.h"
+#include "birkhoff_cart/core/integrators/integrator_kind.h"
 
 namespace birkhoff_cart {
 
@@ -85,6 +86,7 @@ class BirkhoffComposition {
  public:
   static constexpr int kOrder = Weights::kOrder;
   static constexpr bool kSymmetric = true;
+  static constexpr IntegratorKind kKind = IntegratorKind::kComposition;
   /// ê ∝ h⁴: the sub-steps' O((γᵢh)³) terms cancel (Σγᵢ³ = 0); the error-per-step control's exponent.
   static constexpr int kErrorEstimateOrder = 4;
   static const char* name() { return Weights::name(); }

@@ -73,8 +73,8 @@ class GaussCollocation {
   template <class System>
   using Memory = CollocationMemory<System, Stages>;
   static const char* name() {
-    constexpr const char* kNames[] = {"birkhoff2", "birkhoff_gauss4", "birkhoff_gauss6", "birkhoff_gauss8"};
-    return kNames[Stages - 1];
+    static const std::string kName = Stages == 1 ? "birkhoff2" : "birkhoff_gauss" + std::to_string(2 * Stages);
+    return kName.c_str();
   }
 
   GaussCollocation() = default;

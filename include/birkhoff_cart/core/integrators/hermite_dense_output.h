@@ -19,19 +19,20 @@
 #include <Eigen/Core>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace birkhoff_cart {
 
 /// Hermite dense output of a vector of `Size` components over the last `MaxPoints` grid points.
-template <int Size, int MaxPoints = 4>
+template <int Size, int MaxPoints = 5>
 class HermiteDenseOutput {
  public:
   using Vector = Eigen::Matrix<double, Size, 1>;
 
   /// `points`: how many grid points the interpolant uses, 1 … MaxPoints (degree 2·points − 1).
   explicit HermiteDenseOutput(int points = 2) : points_(points) {
-    if (points < 1 || points > MaxPoints) throw std::invalid_argument("Hermite dense output: 1 to 4 points");
+    if (points < 1 || points > MaxPoints) throw std::invalid_argument("Hermite dense output: too many points");
   }
 
   /// Forget every point (a restart of the grid).
@@ -80,34 +81,36 @@ class HermiteDenseOutput {
   }
 
   /// x(t) for t in [oldest_time(), newest_time()] (meant for the newest step); needs ≥ 1 point, each
-  /// with its rate. Exactly the newest point's value at its time.
-  Vector at(double t) const {
+  /// with its rate. Exactly the newest point's value at its time. With `difference`, also the
+  /// interpolant through every point but the oldest, subtracted from it: an estimate of the error of
+  /// the lower-degree one, so a conservative one of this (NaN, unknown, with a single point).
+  Vector at(double t, Vector* difference = nullptr) const {
     if (count_ == 0) throw std::logic_error("Hermite dense output: no grid point yet");
+    if (difference != nullptr) difference->setZero();
     if (t == times_[0]) return values_[0];
     for (int j = 0; j < count_; ++j) {
       if (!has_rate_[j]) throw std::logic_error("Hermite dense output: a grid point without its rate");
     }
-    // Abscissae (doubled), oldest first: τ = t − t_newest keeps full precision in long runs.
+    // Abscissae (doubled), newest first, so that dropping the oldest point drops the last two terms
+    // of the Newton form; τ = t − t_newest keeps full precision in long runs.
     constexpr int kMaxNodes = 2 * MaxPoints;
     std::array<double, kMaxNodes> node{};
     std::array<Vector, kMaxNodes> table;
     table.fill(Vector::Zero());
     const int nodes = 2 * count_;
     for (int j = 0; j < count_; ++j) {
-      const int point = count_ - 1 - j;  // oldest first
-      const double tau = times_[point] - times_[0];
+      const double tau = times_[j] - times_[0];
       node[2 * j] = tau;
       node[2 * j + 1] = tau;
-      table[2 * j] = values_[point];
-      table[2 * j + 1] = values_[point];
+      table[2 * j] = values_[j];
+      table[2 * j + 1] = values_[j];
     }
     // Divided differences in place: after column c, table[i] = f[node[i − c] … node[i]].
     std::array<Vector, kMaxNodes> first;  // first-order column, kept for the confluent entries
     first.fill(Vector::Zero());
     for (int i = nodes - 1; i >= 1; --i) {
       if (node[i] == node[i - 1]) {
-        const int point = count_ - 1 - i / 2;
-        first[i] = rates_[point];  // f[tⱼ, tⱼ] = ẋⱼ
+        first[i] = rates_[i / 2];  // f[tⱼ, tⱼ] = ẋⱼ
       } else {
         first[i] = (table[i] - table[i - 1]) / (node[i] - node[i - 1]);
       }
@@ -116,10 +119,20 @@ class HermiteDenseOutput {
     for (int order = 2; order < nodes; ++order) {
       for (int i = nodes - 1; i >= order; --i) table[i] = (table[i] - table[i - 1]) / (node[i] - node[i - order]);
     }
-    // Horner on the Newton form: P(τ) = Σ_c table[c] Π_{i<c} (τ − node[i]).
+    // The Newton form P(τ) = Σ_c table[c] Π_{i<c} (τ − node[i]), term by term.
     const double tau = t - times_[0];
-    Vector result = table[nodes - 1];
-    for (int c = nodes - 2; c >= 0; --c) result = table[c] + (tau - node[c]) * result;
+    Vector result = table[0];
+    Vector last_two = Vector::Zero();
+    double product = 1.0;
+    for (int c = 1; c < nodes; ++c) {
+      product *= tau - node[c - 1];
+      const Vector term = product * table[c];
+      result += term;
+      if (c >= nodes - 2 && count_ > 1) last_two += term;
+    }
+    if (difference != nullptr) {
+      *difference = count_ > 1 ? last_two : Vector::Constant(std::numeric_limits<double>::quiet_NaN());
+    }
     return result;
   }
 

@@ -32,6 +32,7 @@
 
 #include "birkhoff_cart/core/integrators/cart_stepper.h"
 #include "birkhoff_cart/core/integrators/error_estimate.h"
+#include "birkhoff_cart/core/integrators/integrator_kind.h"
 #include "birkhoff_cart/core/integrators/newton.h"
 
 namespace birkhoff_cart {
@@ -66,6 +67,7 @@ class ImplicitMidpoint {
  public:
   static constexpr int kOrder = 2;
   static constexpr bool kSymmetric = true;
+  static constexpr IntegratorKind kKind = IntegratorKind::kImplicitMidpoint;
   static const char* name() { return "midpoint"; }
 
   ImplicitMidpoint() = default;

@@ -1,6 +1,7 @@
-// The integrator registry: one table of the members (src/core/integrators/integrator_registry.cpp)
-// with what each one is and how it is built. Whatever lists, checks or builds a member reads it:
-// the scene loader, make_cart_stepper, cart_simulate's --help, the node, the benchmarks, the tests.
+// The integrator registry: one table of the members (integrator_members.h; the rows are built in
+// src/core/integrators/integrator_registry.cpp) with what each one is and how it is built. Whatever
+// lists, checks or builds a member reads it: the scene loader, make_cart_stepper, cart_simulate's
+// --help, the node, the benchmarks, the tests.
 #pragma once
 
 #include <memory>
@@ -8,6 +9,7 @@
 #include <vector>
 
 #include "birkhoff_cart/core/integrator_settings.h"
+#include "birkhoff_cart/core/integrators/integrator_kind.h"
 
 namespace birkhoff_cart {
 
@@ -15,37 +17,27 @@ class CartModel;
 class CartStepper;
 class EffectSet;
 
-/// The family of a member's scheme (docs/integrators.md).
-enum class IntegratorKind {
-  kBirkhoffianCollocation,  ///< s-stage Gauss–Legendre collocation in the Darboux chart (order 2s)
-  kComposition,             ///< a symmetric composition of birkhoff2 steps
-  kExplicitRungeKutta,      ///< an explicit Runge–Kutta method at steps of h
-  kAdaptive,                ///< an embedded pair with its own steps inside h, for `tolerance`
-  kImplicitMidpoint,        ///< the implicit midpoint rule on z, solved by Newton
-};
-
-/// "Birkhoffian collocation", "composition", "explicit RK", "adaptive", "implicit midpoint".
-const char* to_string(IntegratorKind kind);
-
 /// Builds a member's stepper for `model` and `effects` (both must outlive it) with `settings`
 /// (its form, Newton and collocation settings, dopri5's tolerance, the reversible control's).
 using CartStepperFactory = std::unique_ptr<CartStepper> (*)(const IntegratorSettings& settings,
                                                             const CartModel& model, const EffectSet& effects);
 
-/// One member of the registry. The claims (order, symmetric, reversible) are checked against the
-/// steppers the factories build by integrator_registry_test (order measured, symmetry by reversal).
+/// One row of the registry: a member of integrator_members.h, everything but the description read
+/// from its stepper type (integrator_registry.cpp). The claims (order, symmetric, reversible) are
+/// checked against the steppers the factories build by integrator_registry_test (order measured)
+/// and registry_properties_test (symmetry by reversal).
 struct IntegratorEntry {
-  const char* name;         ///< integrator.name, --integrator, ~integrator
-  int order;                ///< order of accuracy p [-] (dopri5: that of its 5th-order solution)
-  bool symmetric;           ///< time-symmetric (self-adjoint) step map
-  IntegratorKind kind;      ///< the family of its scheme
-  const char* description;  ///< one line for help texts
-  CartStepperFactory make_fixed;       ///< step_control fixed: steps of h
-  CartStepperFactory make_reversible;  ///< step_control reversible (docs/birkhoffian.md §11); null: not offered
-  CartStepperFactory make_adaptive;    ///< step_control adaptive (docs/birkhoffian.md §12); null: not offered
+  const char* name = "";         ///< integrator.name, --integrator, ~integrator: Stepper::name()
+  int order = 0;                 ///< order of accuracy p [-]: Stepper::kOrder (dopri5: its 5th-order solution's)
+  bool symmetric = false;        ///< time-symmetric (self-adjoint) step map: Stepper::kSymmetric
+  IntegratorKind kind = IntegratorKind::kExplicitRungeKutta;  ///< the family of its scheme: Stepper::kKind
+  const char* description = "";  ///< one line for help texts
+  CartStepperFactory make_fixed = nullptr;       ///< step_control fixed: steps of h
+  CartStepperFactory make_reversible = nullptr;  ///< step_control reversible (docs/birkhoffian.md §11); null: not offered
+  CartStepperFactory make_adaptive = nullptr;    ///< step_control adaptive (docs/birkhoffian.md §12); null: not offered
   /// Evaluates the s stages' right-hand sides of an iteration together, with one vector sin/cos on
   /// CPUs with AVX2 (vector_math.h; docs/integrators.md, "Stage evaluation").
-  bool vector_stages;
+  bool vector_stages = false;
 
   /// Takes step_control reversible (the symmetric Birkhoffian members).
   bool reversible() const { return make_reversible != nullptr; }

@@ -20,6 +20,7 @@
 #include "birkhoff_cart/core/birkhoffian_system.h"
 #include "birkhoff_cart/core/diagnostics.h"
 #include "birkhoff_cart/core/integrators/error_estimate.h"
+#include "birkhoff_cart/core/integrators/integrator_kind.h"
 
 namespace birkhoff_cart {
 
@@ -56,6 +57,7 @@ void joint_rates(const System& system, const StateVector<System, S>& z, const Pa
 struct HeunRungeKutta2 {
   static constexpr int kOrder = 2;
   static constexpr bool kSymmetric = false;
+  static constexpr IntegratorKind kKind = IntegratorKind::kExplicitRungeKutta;
   static const char* name() { return "rk2"; }
 
   template <class System, class S>
@@ -94,6 +96,7 @@ struct HeunRungeKutta2 {
 struct ClassicalRungeKutta4 {
   static constexpr int kOrder = 4;
   static constexpr bool kSymmetric = false;
+  static constexpr IntegratorKind kKind = IntegratorKind::kExplicitRungeKutta;
   static const char* name() { return "rk4"; }
 
   template <class System, class S>

@@ -1,0 +1,132 @@
+// GuardedRun (guarded_run.h): the Simulation and accuracy guard the Python module drives.
+#include "guarded_run.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/step_schedule.h"
+
+namespace birkhoff_cart {
+namespace python {
+
+GuardedRun::GuardedRun(const Scene& scene) : simulation_(scene), guard_(scene.accuracy) {
+  try {
+    steps_between_checks_ = steps_per_interval(1.0 / scene.output_rate, scene.integrator.step_size);
+    checks_at_output_instants_ = true;
+  } catch (const std::invalid_argument&) {
+    steps_between_checks_ = 1;  // output interval no whole number of steps: check after every step
+  }
+  guard_.check(simulation_.schedule().start_time, simulation_.diagnostics(), simulation_.statistics());
+}
+
+void GuardedRun::check_if_due() {
+  // As cart_simulate checks its rows: at the output instants t₀ + k/rate among the whole steps, and
+  // at the run's end.
+  const StepSchedule& schedule = simulation_.schedule();
+  const std::uint64_t n = simulation_.steps_taken();
+  if (n <= schedule.whole_steps && n % steps_between_checks_ == 0) {
+    const double rate = simulation_.scene().output_rate;  // [Hz]
+    const double time = checks_at_output_instants_
+                            ? schedule.start_time + static_cast<double>(n / steps_between_checks_) / rate
+                            : simulation_.state().time;
+    guard_.check(time, simulation_.diagnostics(), simulation_.statistics());
+  } else if (simulation_.at_end()) {
+    guard_.check(schedule.end_time, simulation_.diagnostics(), simulation_.statistics());
+  }
+}
+
+void GuardedRun::step_once() {
+  simulation_.step_on_schedule();
+  check_if_due();
+}
+
+std::uint64_t GuardedRun::advance(std::uint64_t count, const std::vector<StepCommands>& commands, bool record,
+                                  std::vector<CartState>* states) {
+  if (!commands.empty() && commands.size() != count) {
+    throw std::invalid_argument("per-step commands: " + std::to_string(commands.size()) + " given for " +
+                                std::to_string(count) + " steps");
+  }
+  std::uint64_t taken = 0;
+  try {
+    for (; taken < count && !simulation_.at_end(); ++taken) {
+      if (!commands.empty()) {
+        if (!std::isnan(commands[taken].steering)) simulation_.set_steering_command(commands[taken].steering);
+        if (!std::isnan(commands[taken].drive)) simulation_.set_drive_command(commands[taken].drive);
+      }
+      step_once();
+      if (record) states->push_back(simulation_.state());
+    }
+  } catch (const StepError& error) {
+    throw StepError(std::string(error.what()) + " (step " + std::to_string(taken + 1) + " of this call's " +
+                    std::to_string(count) + "; the state is the last good step's)");
+  }
+  return taken;
+}
+
+void GuardedRun::run_to_end() {
+  while (!simulation_.at_end()) step_once();
+}
+
+std::vector<CartState> GuardedRun::states_at(const std::vector<double>& times,
+                                             const std::function<void(const Simulation&)>& observe) {
+  const StepSchedule& schedule = simulation_.schedule();
+  const double h = schedule.step_size;  // [s]
+  const auto describe = [&](double time) {
+    std::ostringstream text;
+    text.precision(17);
+    text << "time " << time << " s";
+    return text.str();
+  };
+  const auto grid = [&]() {
+    std::ostringstream text;
+    text.precision(17);
+    text << "the step schedule's instants t0 + n*h (t0 = " << schedule.start_time << " s, h = " << h
+         << " s) and its end " << schedule.end_time << " s; states between steps are not interpolated";
+    return text.str();
+  };
+  // The step count at each time, checked before any step is taken.
+  std::vector<std::uint64_t> targets;
+  for (std::size_t j = 0; j < times.size(); ++j) {
+    const double time = times[j];
+    if (!std::isfinite(time)) throw std::invalid_argument(describe(time) + " is not finite");
+    if (j > 0 && !(time > times[j - 1])) throw std::invalid_argument("the times must increase: " + describe(time) + " follows " + describe(times[j - 1]));
+    std::uint64_t n = 0;
+    if (std::abs(time - schedule.end_time) <= kTimeResolution * h) {
+      n = schedule.total_steps();
+    } else {
+      const double steps = std::round((time - schedule.start_time) / h);
+      if (!(steps >= 0.0) || steps > static_cast<double>(schedule.whole_steps) ||
+          std::abs(schedule.grid_time(static_cast<std::uint64_t>(steps)) - time) > kTimeResolution * h) {
+        throw std::invalid_argument(describe(time) + " is not one of " + grid());
+      }
+      n = static_cast<std::uint64_t>(steps);
+    }
+    if (n < simulation_.steps_taken()) {
+      std::ostringstream text;
+      text.precision(17);
+      text << describe(time) << " is in the past: the run is at t = " << simulation_.state().time << " s";
+      throw std::invalid_argument(text.str());
+    }
+    targets.push_back(n);
+  }
+  std::vector<CartState> states;
+  states.reserve(times.size());
+  for (std::uint64_t n : targets) {
+    while (simulation_.steps_taken() < n) step_once();
+    states.push_back(simulation_.state());
+    if (observe) observe(simulation_);
+  }
+  return states;
+}
+
+void GuardedRun::reset() {
+  simulation_.reset();
+  guard_.reset();
+  guard_.check(simulation_.schedule().start_time, simulation_.diagnostics(), simulation_.statistics());
+}
+
+}  // namespace python
+}  // namespace birkhoff_cart
