@@ -13,7 +13,8 @@ line as "<file name> <minimum number of test cases>". A run fails (exit status 1
   - a listed result file is missing (the binary was never built, registered or run) or holds
     fewer cases than listed (an empty result, a suite that lost its cases);
   - a result file is not listed (a new test: add it to the manifest);
-  - with --sources, a test source (test/unit/*.cpp, test/ros_unit/*.cpp, test/integration/*.test)
+  - with --sources, a test source (test/unit/*.cpp, test/ros_unit/*.cpp, test/integration/*.test,
+    test/python/test_*.py)
     has no line in the manifest (a test that would never be expected);
   - no case ran at all.
 """
@@ -48,6 +49,8 @@ def expected_from_sources(repo: pathlib.Path):
                 names.append((f"gtest-{source.stem}.xml", source))
     for launch in sorted((repo / "test/integration").glob("*.test")):
         names.append((f"rostest-test_integration_{launch.stem}.xml", launch))
+    for source in sorted((repo / "test/python").glob("test_*.py")):  # one pytest run for them all
+        names.append(("pytest-study_units.xml", source))
     return names
 
 

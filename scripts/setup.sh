@@ -35,6 +35,8 @@ packages=(
   python3-matplotlib python3-numpy
   # the study runner (scripts/study): Dask distributed, its local cluster and the row tables
   python3-distributed python3-dask python3-pandas python3-yaml
+  # its study-file schema (python3-jsonschema) and its unit tests (python3-pytest: scripts/run_tests.sh)
+  python3-jsonschema python3-pytest
 )
 missing=()
 for package in "${packages[@]}"; do
