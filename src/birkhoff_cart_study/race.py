@@ -125,7 +125,8 @@ def _crossover_cell(peer_runs, birkhoffian_runs, error_floor):
     def resolved(runs):
         return envelope([r for r in runs if _usable(r.get("error")) and r["error"] >= error_floor], "error")
     text = describe_crossover(resolved(peer_runs), resolved(birkhoffian_runs))
-    return text + ("; errors below %.2g m unresolved" % error_floor if error_floor > 0 else "")
+    clipped = any(_usable(r.get("error")) and r["error"] < error_floor for r in peer_runs + birkhoffian_runs)
+    return text + ("; errors below %.2g m unresolved" % error_floor if clipped else "")
 
 
 def _at_goal(peer, birkhoffian, goal):
@@ -169,7 +170,7 @@ def race(runs, goals, is_birkhoffian, unresolved=None, error_floor=0.0):
     span_text = "runs from %s to %s" % (_m(span[0][0]), _m(span[-1][0])) if span else "—"
     if math.isinf(error_floor):
         span_text = "unresolved"
-    elif error_floor > 0:
+    elif span and span[0][0] < error_floor:
         span_text += "; errors below %.2g m unresolved" % error_floor
     lines.append("| *best Birkhoffian* | %s | %s |" % (" | ".join(best), span_text))
 

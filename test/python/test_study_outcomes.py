@@ -101,6 +101,9 @@ def test_the_race_gives_no_verdict_and_no_ratio_for_an_unresolved_goal():
     assert rk4.split(" | ")[1].startswith("2.00× met (2 s)") and rk4.split(" | ")[2] == "unresolved"
     assert "unresolved: no verdict" in table
     assert "at 1 of 1 goals" in summary and "No verdict for error ≤ 1e-08 m" in summary
+    assert "errors below 1e-07 m unresolved" in rk4  # the crossover from resolved errors only
+    table, _ = race(runs, goals, lambda m: m.startswith("birkhoff"), {}, error_floor=1e-13)
+    assert "unresolved" not in table  # a floor below every error clips nothing
 
 
 def rows_of(tasks, outcome_of):
