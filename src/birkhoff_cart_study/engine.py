@@ -16,7 +16,6 @@ import sys
 import time
 
 from .kinds import module_of
-from .task_runner import run_task
 
 ROWS_FILE = "rows.jsonl"
 TASK_RETRIES = 2       # reruns of a task whose worker died (besides the scheduler's own reassignment)
@@ -107,8 +106,9 @@ class SchedulerUnreachable(Exception):
 
 def _register_code():
     """The tasks' code travels with them: workers started by `dask-worker` need the package's
-    executables, not its Python modules on their path. (Dask pickles by value only functions
-    whose own module is registered, hence each module by name.)"""
+    executables, not its Python modules on their path. (Dask pickles by value only a submitted
+    function whose own module is registered, hence each module by name, and each kind's `run` is
+    the function submitted: a function passed as an argument would go by reference.)"""
     import cloudpickle
     import birkhoff_cart_study
     from birkhoff_cart_study import cli_contract, race, task_runner, tasks
@@ -205,7 +205,7 @@ def run_study(study, tasks, output_dir, bin_dir, scheduler=None, workers=None, s
         def submit(task):
             wire = kind.wire(task, bin_dir)
             reference = references.get(task.settings.get("reference")) if wire.get("needs_reference") else None
-            future = client.submit(run_task, wire, kind.outcome, reference, key="%s-%s" % (task.kind.value, task.id),
+            future = client.submit(kind.run, wire, reference, key="%s-%s" % (task.kind.value, task.id),
                                    pure=False, retries=TASK_RETRIES)
             if task.kind.value == "reference":
                 references[task.label] = future

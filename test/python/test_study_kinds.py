@@ -28,7 +28,7 @@ def test_the_kinds_table_has_one_module_per_kind():
     assert set(kinds.KINDS) == set(StudyKind)
     for kind, module in kinds.KINDS.items():
         assert module.KIND is kind
-        for function in ("schema", "smoke", "expand", "wire", "outcome", "report"):
+        for function in ("schema", "smoke", "expand", "wire", "run", "outcome", "report"):
             assert callable(getattr(module, function)), (kind, function)
 
 

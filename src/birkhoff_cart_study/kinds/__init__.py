@@ -1,5 +1,5 @@
 """The study kinds: one module each, with its schema, its smoke size, its expansion into tasks, its
-command line (wire), its outcome and its report. KINDS is the one table the runner dispatches on."""
+command line (wire), its outcome (run on the worker: run) and its report. KINDS is the one table the runner dispatches on."""
 from ..tasks import StudyKind
 from . import cli_runs, random_carts, work_precision
 

@@ -156,6 +156,7 @@ def _product_tasks(path, where, experiment, doc, context):
 
 wire = simulate.wire
 outcome = simulate.outcome
+run = simulate.run
 
 
 def _distance(a, b):

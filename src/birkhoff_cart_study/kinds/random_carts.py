@@ -54,6 +54,7 @@ def expand(path, doc, context):
 
 wire = simulate.wire
 outcome = simulate.outcome
+run = simulate.run
 
 
 def report(study, rows, directory, stem):

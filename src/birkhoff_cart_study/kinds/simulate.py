@@ -1,13 +1,15 @@
 """cart_simulate runs as tasks, shared by the cli_runs and random_carts kinds: the command line of a
 run, its outcome under the CLI contract (cli_contract.py), and the outcome tables of the report.
 
-`wire` runs on the study runner (at submission); `outcome` on the worker, with the standard library
-and cli_contract only."""
+`wire` runs on the study runner (at submission); `run` and `outcome` on the worker, with the standard
+library, task_runner and cli_contract only (Dask sends them by value: workers need the executables,
+not this package)."""
 import os
 import re
 
 from ..cli_contract import judge, with_start_time
 from ..race import cpu_text
+from ..task_runner import run_task
 
 # task setting → cart_simulate option (the tolerance's option depends on the step control)
 OPTIONS = (("step", "--step"), ("duration", "--duration"), ("output_rate", "--output-rate"),
@@ -74,6 +76,11 @@ def outcome(wire, process):
         if reason:
             row["reason"] = reason
     return row
+
+
+def run(wire, reference=None):
+    """One task on a worker (what the runner submits): its row."""
+    return run_task(wire, outcome, reference)
 
 
 def _cell(text):

@@ -15,6 +15,7 @@ from typing import Callable
 
 from .. import schema as s
 from .. import scenes
+from ..task_runner import run_task
 from ..tasks import StudyKind, Task, TaskKind
 
 KIND = StudyKind.WORK_PRECISION
@@ -242,6 +243,11 @@ def outcome(wire, process):
         row["reason"] = str((result or {}).get("status") if isinstance(result, dict) else "") or \
             "exit status %d" % process.status
     return row
+
+
+def run(wire, reference=None):
+    """One task on a worker (what the runner submits; Dask sends it by value): its row."""
+    return run_task(wire, outcome, reference)
 
 
 def report(study, rows, directory, stem):
