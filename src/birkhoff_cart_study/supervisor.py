@@ -1,19 +1,20 @@
-"""The supervisor of one task's process: run as its own process (`python3 -I -S -c SOURCE SPEC`) in
-a session of its own by the worker's thread, so that it outlives the worker and its thread.
+"""The supervisor of a worker thread's task processes: a process of its own (`python3 -I -S -c
+SOURCE`), started once per worker thread in a session of its own, so that it outlives the worker
+and its thread; it runs that thread's tasks one after the other.
 
-It makes the task directory (birkhoff_cart_task_* in $TMPDIR), writes the task's input files there
-and starts the task's process in a new process group, which dies with the supervisor
-(PR_SET_PDEATHSIG). Its standard input is the lifeline: the worker holds the other end and never
-writes. The supervisor prints two JSON lines on standard output,
-    {"directory": DIR, "pid": PID}                              once the process has started,
-    {"status": S, "cpu_s": C, "wall_s": W, "timed_out": B}    when it has ended (or was killed
-                                                                past the time limit),
-and then waits for the lifeline to close (the worker has read the outputs). Whenever the lifeline
-closes — the task is done or cancelled, or its worker died, however — the supervisor kills the
-process group, removes the directory and exits: no orphan, no leaked directory.
-
-SPEC is a JSON object: {"argv": [...], "files": {NAME: TEXT}, "time_limit": SECONDS}. Standard
-library only (it runs without the package on any worker)."""
+Its standard input is the lifeline and its command channel: the worker holds the other end. The
+worker writes one JSON line per command and reads one JSON line per answer on its standard output:
+    {"op": "run", "argv": [...], "files": {NAME: TEXT}, "time_limit": SECONDS}
+        → {"directory": DIR, "pid": PID}  once the task's process has started in a new task
+          directory (birkhoff_cart_task_* in $TMPDIR, with the files written there) and a new
+          process group that dies with the supervisor (PR_SET_PDEATHSIG), or {"error": WHY};
+        → {"status": S, "cpu_s": C, "wall_s": W, "timed_out": B}  when it has ended, or was
+          killed past its time limit (what is left of its group is killed too);
+    {"op": "done"}   the worker has read the outputs: the directory is removed;
+    {"op": "stop"}   the task is cancelled: its process group is killed, its directory removed.
+Whenever the lifeline closes — the worker is done with its thread, or died, however — the
+supervisor kills the running process group, removes the directory and exits: no orphan, no leaked
+directory. Standard library only (it runs without the package on any worker)."""
 import ctypes
 import json
 import os
@@ -25,8 +26,12 @@ import sys
 import tempfile
 import time
 
-POLL = 0.02  # [s] between looks at the lifeline and the process
+POLL = 0.02  # [s] between looks at the lifeline and the running process
 PR_SET_PDEATHSIG = 1
+
+
+class LifelineClosed(Exception):
+    pass
 
 
 def _die_with_parent():
@@ -44,10 +49,24 @@ def _kill_group(pid):
         pass
 
 
-def _lifeline_closed(timeout):
-    """True when the worker's end of standard input is closed (EOF) within `timeout` [s]."""
-    ready, _, _ = select.select([0], [], [], timeout)
-    return bool(ready) and os.read(0, 4096) == b""
+class Commands:
+    """The JSON lines on standard input; LifelineClosed at its end."""
+
+    def __init__(self):
+        self.buffer = b""
+
+    def next(self, timeout=None):
+        """The next command, or None when none came within `timeout` [s] (None: wait)."""
+        while b"\n" not in self.buffer:
+            ready, _, _ = select.select([0], [], [], timeout)
+            if not ready:
+                return None
+            chunk = os.read(0, 65536)
+            if not chunk:
+                raise LifelineClosed()
+            self.buffer += chunk
+        line, self.buffer = self.buffer.split(b"\n", 1)
+        return json.loads(line)
 
 
 def _say(message):
@@ -55,57 +74,91 @@ def _say(message):
     sys.stdout.flush()
 
 
+class Task:
+    """One task's directory and process group."""
+
+    def __init__(self, spec):
+        self.directory = tempfile.mkdtemp(prefix="birkhoff_cart_task_")
+        self.child = None
+        for name, text in spec.get("files", {}).items():
+            with open(os.path.join(self.directory, os.path.basename(name)), "w") as f:
+                f.write(text)
+        try:
+            with open(os.path.join(self.directory, "stdout"), "wb") as out, \
+                    open(os.path.join(self.directory, "stderr"), "wb") as err:
+                self.start = time.monotonic()
+                self.child = subprocess.Popen(spec["argv"], cwd=self.directory, stdout=out, stderr=err,
+                                              stdin=subprocess.DEVNULL, start_new_session=True,
+                                              preexec_fn=_die_with_parent)
+        except OSError:
+            shutil.rmtree(self.directory, ignore_errors=True)
+            raise
+
+    def wait(self, commands, time_limit):
+        """The report once the process ends (or is killed past `time_limit`); None when the task
+        was stopped meanwhile."""
+        timed_out = False
+        while True:
+            pid, status, usage = os.wait4(self.child.pid, os.WNOHANG)
+            if pid:
+                break
+            if time.monotonic() - self.start > time_limit:
+                timed_out = True
+                _kill_group(self.child.pid)
+                pid, status, usage = os.wait4(self.child.pid, 0)
+                break
+            command = commands.next(POLL)
+            if command is not None and command.get("op") == "stop":
+                return None
+        wall = time.monotonic() - self.start
+        _kill_group(self.child.pid)  # whatever the process left behind in its group
+        self.child.returncode = os.waitstatus_to_exitcode(status)
+        return {"status": self.child.returncode, "cpu_s": usage.ru_utime + usage.ru_stime, "wall_s": wall,
+                "timed_out": timed_out}
+
+    def remove(self):
+        if self.child is not None and self.child.returncode is None:
+            _kill_group(self.child.pid)
+            try:
+                os.waitpid(self.child.pid, 0)
+            except ChildProcessError:
+                pass
+        shutil.rmtree(self.directory, ignore_errors=True)
+
+
 def _stop(number, frame):
-    raise SystemExit(3)  # SIGTERM, SIGHUP: kill and clean up as for a closed lifeline
+    raise LifelineClosed()  # SIGTERM, SIGHUP: kill and clean up as for a closed lifeline
 
 
 def main():
     for number in (signal.SIGTERM, signal.SIGHUP):
         signal.signal(number, _stop)
-    spec = json.loads(sys.argv[1])
-    directory = tempfile.mkdtemp(prefix="birkhoff_cart_task_")
-    child = None
+    commands = Commands()
+    task = None
     try:
-        for name, text in spec.get("files", {}).items():
-            with open(os.path.join(directory, os.path.basename(name)), "w") as f:
-                f.write(text)
-        with open(os.path.join(directory, "stdout"), "wb") as out, open(os.path.join(directory, "stderr"), "wb") as err:
-            start = time.monotonic()
-            child = subprocess.Popen(spec["argv"], cwd=directory, stdout=out, stderr=err, stdin=subprocess.DEVNULL,
-                                     start_new_session=True, preexec_fn=_die_with_parent)
-        _say({"directory": directory, "pid": child.pid})
-        timed_out = False
         while True:
-            pid, status, usage = os.wait4(child.pid, os.WNOHANG)
-            if pid:
-                break
-            if time.monotonic() - start > spec["time_limit"]:
-                timed_out = True
-                _kill_group(child.pid)
-                pid, status, usage = os.wait4(child.pid, 0)
-                break
-            if _lifeline_closed(POLL):
-                return 3  # cancelled, or the worker is gone: the finally clause kills and cleans
-        wall = time.monotonic() - start
-        _kill_group(child.pid)  # whatever the process left behind in its group
-        child.returncode = os.waitstatus_to_exitcode(status)
-        _say({"status": child.returncode, "cpu_s": usage.ru_utime + usage.ru_stime, "wall_s": wall,
-              "timed_out": timed_out})
-        while not _lifeline_closed(1.0):
-            pass
+            command = commands.next()
+            if command.get("op") != "run":
+                continue  # a late "done" or "stop" of a task already cleaned up
+            try:
+                task = Task(command)
+            except OSError as error:
+                _say({"error": "cannot start %s: %s" % (command["argv"][0], error.strerror or error)})
+                continue
+            _say({"directory": task.directory, "pid": task.child.pid})
+            report = task.wait(commands, command["time_limit"])
+            if report is not None:
+                _say(report)
+                while command.get("op") not in ("done", "stop"):
+                    command = commands.next()
+            task.remove()
+            task = None
+    except (LifelineClosed, BrokenPipeError):
         return 0
     finally:
-        if child is not None and child.returncode is None:
-            _kill_group(child.pid)
-            try:
-                os.waitpid(child.pid, 0)
-            except ChildProcessError:
-                pass
-        shutil.rmtree(directory, ignore_errors=True)
+        if task is not None:
+            task.remove()
 
 
 if __name__ == "__main__":
-    try:
-        sys.exit(main())
-    except BrokenPipeError:  # the worker is gone before reading: nothing to tell
-        sys.exit(3)
+    sys.exit(main())

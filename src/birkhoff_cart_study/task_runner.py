@@ -2,10 +2,11 @@
 
 This module is what workers execute: it needs only the standard library and the package's
 executables (the task's argument list names them by their path, the same on every worker). The
-process runs under its supervisor (supervisor.py), a process of its own that outlives the worker's
-thread: it enforces the time limit, and it kills the process and removes the task directory as
-soon as the worker lets go of it — the task done, cancelled (the runner's SIGINT or SIGTERM, its
-client gone), or the worker dead."""
+process runs under its worker thread's supervisor (supervisor.py), a process of its own, started
+once and reused task after task, that outlives the worker and its thread: it enforces the time
+limit, removes the task directory when the row is made, and stops the process and removes its
+directory as soon as the task is cancelled (the runner's SIGINT or SIGTERM, its client gone) or
+the worker is gone, however it ended."""
 import json
 import os
 import select
@@ -13,6 +14,7 @@ import signal
 import socket
 import subprocess
 import sys
+import threading
 import time
 
 STDERR_TAIL = 2000         # characters of a failed process's stderr kept in its row
@@ -84,59 +86,133 @@ class Process:
         return os.path.join(self.directory, name)
 
 
-class Supervised:
-    """`with Supervised(argv, files, time_limit) as process:` runs argv under its supervisor and
-    gives the Process; leaving the block lets the supervisor kill what is left and remove the task
-    directory. Raises Cancelled when `cancelled()` turns true first."""
+class SupervisorProcess:
+    """A running supervisor (supervisor.py) and its command channel: JSON lines both ways."""
 
-    def __init__(self, argv, files, time_limit, cancelled=dask_task_cancelled):
-        self.spec = {"argv": argv, "files": files, "time_limit": time_limit}
-        self.cancelled = cancelled
-        self.deadline = time.monotonic() + time_limit + SUPERVISOR_GRACE
+    def __init__(self):
+        self.process = subprocess.Popen([sys.executable, "-I", "-S", "-c", SUPERVISOR_SOURCE], stdin=subprocess.PIPE,
+                                        stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
         self.buffer = b""
-        self.supervisor = None
 
-    def _line(self):
-        fd = self.supervisor.stdout.fileno()
+    def alive(self):
+        return self.process.poll() is None
+
+    def send(self, message):
+        try:
+            self.process.stdin.write((json.dumps(message) + "\n").encode())
+            self.process.stdin.flush()
+        except (BrokenPipeError, ValueError):
+            raise SupervisorFailed("the supervisor is gone")
+
+    def answer(self, cancelled, deadline):
+        """The supervisor's next answer; Cancelled when `cancelled()` turns true first."""
+        fd = self.process.stdout.fileno()
         while b"\n" not in self.buffer:
             ready, _, _ = select.select([fd], [], [], POLL)
             if ready:
                 chunk = os.read(fd, 65536)
                 if not chunk:
-                    raise SupervisorFailed("the supervisor ended without a result: %s"
-                                           % self.supervisor.stderr.read(2000).decode(errors="replace").strip()[-300:])
+                    self.process.wait()
+                    raise SupervisorFailed("the supervisor ended without a result (exit %s): %s" % (
+                        self.process.returncode, self.process.stderr.read(2000).decode(errors="replace").strip()[-300:]))
                 self.buffer += chunk
-            elif self.cancelled():
+            elif cancelled():
                 raise Cancelled()
-            elif time.monotonic() > self.deadline:
+            elif time.monotonic() > deadline:
                 raise SupervisorFailed("no result from the supervisor %g s past the time limit" % SUPERVISOR_GRACE)
         line, self.buffer = self.buffer.split(b"\n", 1)
         return json.loads(line)
 
-    def __enter__(self):
-        self.supervisor = subprocess.Popen([sys.executable, "-I", "-S", "-c", SUPERVISOR_SOURCE, json.dumps(self.spec)],
-                                           stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                           start_new_session=True)
+    def close(self):
+        """Closes the lifeline: the supervisor kills what runs, cleans up and exits."""
         try:
-            started = self._line()
-            return Process(self._line(), started["directory"])
-        except BaseException:
-            self.__exit__(None, None, None)
+            self.process.stdin.close()
+        except (BrokenPipeError, ValueError):
+            pass
+        try:
+            self.process.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            self.process.send_signal(signal.SIGTERM)
+            try:
+                self.process.wait(timeout=2)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait()
+        self.process.stdout.close()
+        self.process.stderr.close()
+
+
+def worker_supervisors():
+    """The supervisors of this Dask worker's threads ({thread id: SupervisorProcess}), kept on the
+    Worker object, which outlives its tasks; None outside a worker."""
+    try:
+        from distributed import get_worker
+        worker = get_worker()
+    except (ImportError, ValueError):
+        return None
+    pool = getattr(worker, "_birkhoff_cart_supervisors", None)
+    if pool is None:
+        pool = worker._birkhoff_cart_supervisors = {}
+    return pool
+
+
+class Supervised:
+    """`with Supervised(argv, files, time_limit) as process:` runs argv under the thread's
+    supervisor and gives the Process; leaving the block lets the supervisor remove the task
+    directory. Raises Cancelled when `cancelled()` turns true first (the supervisor then stops the
+    process). `pool`: the worker's supervisors, one per thread, reused task after task; without
+    one, a supervisor of its own is started and closed around the task."""
+
+    def __init__(self, argv, files, time_limit, cancelled=dask_task_cancelled, pool=None):
+        self.spec = {"op": "run", "argv": argv, "files": files, "time_limit": time_limit}
+        self.cancelled = cancelled
+        self.deadline = time.monotonic() + time_limit + SUPERVISOR_GRACE
+        self.pool = pool
+        self.supervisor = None
+
+    def _supervisor(self):
+        if self.pool is None:
+            return SupervisorProcess()
+        thread = threading.get_ident()
+        living = {t.ident for t in threading.enumerate()}
+        for ident in [i for i in self.pool if i not in living]:  # a thread gone: its supervisor too
+            self.pool.pop(ident).close()
+        supervisor = self.pool.get(thread)
+        if supervisor is None or not supervisor.alive():
+            supervisor = self.pool[thread] = SupervisorProcess()
+        return supervisor
+
+    def __enter__(self):
+        self.supervisor = self._supervisor()
+        try:
+            self.supervisor.send(self.spec)
+            started = self.supervisor.answer(self.cancelled, self.deadline)
+            if "error" in started:
+                raise SupervisorFailed(started["error"])
+            return Process(self.supervisor.answer(self.cancelled, self.deadline), started["directory"])
+        except Cancelled:
+            self._finish("stop")
+            raise
+        except SupervisorFailed:
+            self._discard()
             raise
 
-    def __exit__(self, *exception):
-        self.supervisor.stdin.close()  # the lifeline: the supervisor kills, cleans up and exits
+    def _finish(self, op):
         try:
-            self.supervisor.wait(timeout=5)
-        except subprocess.TimeoutExpired:
-            self.supervisor.send_signal(signal.SIGTERM)
-            try:
-                self.supervisor.wait(timeout=2)
-            except subprocess.TimeoutExpired:
-                self.supervisor.kill()
-                self.supervisor.wait()
-        self.supervisor.stdout.close()
-        self.supervisor.stderr.close()
+            self.supervisor.send({"op": op})
+        except SupervisorFailed:
+            self._discard()
+            return
+        if self.pool is None:
+            self.supervisor.close()
+
+    def _discard(self):
+        if self.pool is not None and self.pool.get(threading.get_ident()) is self.supervisor:
+            del self.pool[threading.get_ident()]
+        self.supervisor.close()
+
+    def __exit__(self, *exception):
+        self._finish("done")
         return False
 
 
@@ -164,7 +240,7 @@ def run_task(wire, outcome, reference=None, cancelled=dask_task_cancelled):
             return row
         files["reference.csv"] = text
     try:
-        with Supervised(wire["argv"], files, wire["time_limit"], cancelled) as process:
+        with Supervised(wire["argv"], files, wire["time_limit"], cancelled, worker_supervisors()) as process:
             row.update(outcome(wire, process))
     except SupervisorFailed as error:
         row.update(outcome="failed", reason=str(error))

@@ -1,16 +1,18 @@
-"""No orphans, no leaks: a task's process runs under its supervisor, which stops it and removes the
-task directory when the task ends, passes its time limit, is cancelled, or when the worker that
-started it dies (SIGKILL) — within a second, found by a marker in the process table."""
+"""No orphans, no leaks: a task's process runs under its worker thread's supervisor, which stops it
+and removes the task directory when the task ends, passes its time limit, is cancelled, or when
+the worker that started it dies (SIGKILL) — within a second, found by a marker in the process
+table; the supervisor serves the thread's tasks one after the other."""
 import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 import uuid
 
 import pytest
 
-from birkhoff_cart_study.task_runner import Cancelled, Supervised, run_task
+from birkhoff_cart_study.task_runner import Cancelled, Supervised, SupervisorFailed, run_task
 from conftest import REPOSITORY
 
 SETTLE = 2.0  # [s] after which nothing of a stopped task may be left
@@ -113,3 +115,28 @@ def test_run_task_makes_a_row_of_a_crash_and_of_a_missing_reference(tmp):
                    lambda wire, process: {"outcome": "ok"}, reference={"outcome": "failed"})
     assert row == dict(row, outcome="failed", reason="its reference did not finish")
     assert not task_directories(tmp)
+
+
+def test_a_worker_thread_reuses_its_supervisor_and_a_cancelled_task_leaves_it_usable(tmp):
+    pool = {}
+    pids = []
+    for _ in range(3):
+        with Supervised(["/bin/sh", "-c", "exit 0"], {}, 10.0, pool=pool) as process:
+            assert process.status == 0
+        pids.append(pool[threading.get_ident()].process.pid)
+    assert len(set(pids)) == 1  # one supervisor process for the thread's tasks
+    command, marker = marked_sleeper()
+    cancel_at = time.monotonic() + 0.3
+    with pytest.raises(Cancelled):
+        with Supervised(command, {}, 60.0, cancelled=lambda: time.monotonic() > cancel_at, pool=pool):
+            pass
+    assert wait_until(lambda: not processes_with(marker) and not task_directories(tmp), 1.0)
+    with Supervised(["/bin/sh", "-c", "exit 7"], {}, 10.0, pool=pool) as process:
+        assert process.status == 7
+    assert pool[threading.get_ident()].process.pid == pids[0]
+    with pytest.raises(SupervisorFailed, match="cannot start /nonexistent/engine"):
+        with Supervised(["/nonexistent/engine"], {}, 10.0, pool=pool):
+            pass
+    assert not task_directories(tmp)
+    for supervisor in pool.values():
+        supervisor.close()
