@@ -22,7 +22,7 @@ import time
 REPOSITORY = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 sys.path.insert(0, os.path.join(REPOSITORY, "src"))
 
-from birkhoff_cart_study.task_runner import Supervised  # noqa: E402
+from birkhoff_cart_study.task_runner import Supervised, SupervisorProcess  # noqa: E402
 
 FULL_CARTS = 100000  # the study the projection is for
 INTEGRATORS = 3      # random_carts.yaml runs each cart with three integrators
@@ -62,8 +62,8 @@ def supervisor_cost(count=40):
             with Supervised(["/bin/true"], {"scene.yaml": "x" * 4000}, 10.0, cancelled=lambda: False, pool=pool):
                 pass
         costs.append((time.monotonic() - start) / count)
-        for supervisor in (pool or {}).values():
-            supervisor.close()
+        for state in (pool or {}).values():
+            SupervisorProcess(state).close()
     return costs
 
 

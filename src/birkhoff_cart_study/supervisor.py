@@ -4,14 +4,16 @@ and its thread; it runs that thread's tasks one after the other.
 
 Its standard input is the lifeline and its command channel: the worker holds the other end. The
 worker writes one JSON line per command and reads one JSON line per answer on its standard output:
-    {"op": "run", "argv": [...], "files": {NAME: TEXT}, "time_limit": SECONDS}
+    {"op": "run", "id": N, "argv": [...], "files": {NAME: TEXT}, "time_limit": SECONDS}
         → {"directory": DIR, "pid": PID}  once the task's process has started in a new task
           directory (birkhoff_cart_task_* in $TMPDIR, with the files written there) and a new
           process group that dies with the supervisor (PR_SET_PDEATHSIG), or {"error": WHY};
         → {"status": S, "cpu_s": C, "wall_s": W, "timed_out": B}  when it has ended, or was
           killed past its time limit (what is left of its group is killed too);
-    {"op": "done"}   the worker has read the outputs: the directory is removed;
-    {"op": "stop"}   the task is cancelled: its process group is killed, its directory removed.
+    {"op": "done", "id": N}   the worker has read the outputs: the directory is removed;
+    {"op": "stop", "id": N}   the task is cancelled: its process group is killed, its directory removed.
+Every answer carries the id of its task, and a command for another task than the running one is
+ignored: a cancelled task's late answer never passes for the next task's.
 Whenever the lifeline closes — the worker is done with its thread, or died, however — the
 supervisor kills the running process group, removes the directory and exits: no orphan, no leaked
 directory. Standard library only (it runs without the package on any worker)."""
@@ -78,6 +80,7 @@ class Task:
     """One task's directory and process group."""
 
     def __init__(self, spec):
+        self.id = spec.get("id")
         self.directory = tempfile.mkdtemp(prefix="birkhoff_cart_task_")
         self.child = None
         for name, text in spec.get("files", {}).items():
@@ -108,7 +111,7 @@ class Task:
                 pid, status, usage = os.wait4(self.child.pid, 0)
                 break
             command = commands.next(POLL)
-            if command is not None and command.get("op") == "stop":
+            if command is not None and command.get("op") == "stop" and command.get("id") == self.id:
                 return None
         wall = time.monotonic() - self.start
         _kill_group(self.child.pid)  # whatever the process left behind in its group
@@ -143,13 +146,14 @@ def main():
             try:
                 task = Task(command)
             except OSError as error:
-                _say({"error": "cannot start %s: %s" % (command["argv"][0], error.strerror or error)})
+                _say({"id": command.get("id"), "error": "cannot start %s: %s" % (command["argv"][0],
+                                                                                  error.strerror or error)})
                 continue
-            _say({"directory": task.directory, "pid": task.child.pid})
+            _say({"id": task.id, "directory": task.directory, "pid": task.child.pid})
             report = task.wait(commands, command["time_limit"])
             if report is not None:
-                _say(report)
-                while command.get("op") not in ("done", "stop"):
+                _say(dict(report, id=task.id))
+                while not (command.get("op") in ("done", "stop") and command.get("id") == task.id):
                     command = commands.next()
             task.remove()
             task = None

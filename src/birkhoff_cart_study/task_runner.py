@@ -87,12 +87,25 @@ class Process:
 
 
 class SupervisorProcess:
-    """A running supervisor (supervisor.py) and its command channel: JSON lines both ways."""
+    """A running supervisor (supervisor.py) and its command channel: JSON lines both ways.
 
-    def __init__(self):
-        self.process = subprocess.Popen([sys.executable, "-I", "-S", "-c", SUPERVISOR_SOURCE], stdin=subprocess.PIPE,
-                                        stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
-        self.buffer = b""
+    Its state is a plain dict (the process, the unread answers, the latest task's id), which a
+    worker keeps across tasks: each task's code arrives by value, with classes of its own, so a
+    worker must not hold objects of an earlier task's classes (their exceptions would not be the
+    ones the later code catches)."""
+
+    def __init__(self, state=None):
+        if state is None:
+            state = {"process": subprocess.Popen([sys.executable, "-I", "-S", "-c", SUPERVISOR_SOURCE],
+                                                 stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                                 start_new_session=True),
+                     "buffer": b"", "task": 0}
+        self.state = state
+        self.process = state["process"]
+
+    @property
+    def task(self):
+        return self.state["task"]
 
     def alive(self):
         return self.process.poll() is None
@@ -104,10 +117,23 @@ class SupervisorProcess:
         except (BrokenPipeError, ValueError):
             raise SupervisorFailed("the supervisor is gone")
 
+    def run(self, spec):
+        """Sends a task; returns its id (every answer about it carries it)."""
+        self.state["task"] += 1
+        self.send(dict(spec, id=self.task))
+        return self.task
+
     def answer(self, cancelled, deadline):
-        """The supervisor's next answer; Cancelled when `cancelled()` turns true first."""
+        """The supervisor's next answer about the latest task (a late answer about a cancelled one
+        is skipped); Cancelled when `cancelled()` turns true first."""
+        while True:
+            message = self._line(cancelled, deadline)
+            if message.get("id") == self.task:
+                return message
+
+    def _line(self, cancelled, deadline):
         fd = self.process.stdout.fileno()
-        while b"\n" not in self.buffer:
+        while b"\n" not in self.state["buffer"]:
             ready, _, _ = select.select([fd], [], [], POLL)
             if ready:
                 chunk = os.read(fd, 65536)
@@ -115,12 +141,12 @@ class SupervisorProcess:
                     self.process.wait()
                     raise SupervisorFailed("the supervisor ended without a result (exit %s): %s" % (
                         self.process.returncode, self.process.stderr.read(2000).decode(errors="replace").strip()[-300:]))
-                self.buffer += chunk
+                self.state["buffer"] += chunk
             elif cancelled():
                 raise Cancelled()
             elif time.monotonic() > deadline:
                 raise SupervisorFailed("no result from the supervisor %g s past the time limit" % SUPERVISOR_GRACE)
-        line, self.buffer = self.buffer.split(b"\n", 1)
+        line, self.state["buffer"] = self.state["buffer"].split(b"\n", 1)
         return json.loads(line)
 
     def close(self):
@@ -143,8 +169,8 @@ class SupervisorProcess:
 
 
 def worker_supervisors():
-    """The supervisors of this Dask worker's threads ({thread id: SupervisorProcess}), kept on the
-    Worker object, which outlives its tasks; None outside a worker."""
+    """The supervisors of this Dask worker's threads ({thread id: a SupervisorProcess's state}),
+    kept on the Worker object, which outlives its tasks; None outside a worker."""
     try:
         from distributed import get_worker
         worker = get_worker()
@@ -176,16 +202,18 @@ class Supervised:
         thread = threading.get_ident()
         living = {t.ident for t in threading.enumerate()}
         for ident in [i for i in self.pool if i not in living]:  # a thread gone: its supervisor too
-            self.pool.pop(ident).close()
-        supervisor = self.pool.get(thread)
+            SupervisorProcess(self.pool.pop(ident)).close()
+        state = self.pool.get(thread)
+        supervisor = SupervisorProcess(state) if state is not None else None
         if supervisor is None or not supervisor.alive():
-            supervisor = self.pool[thread] = SupervisorProcess()
+            supervisor = SupervisorProcess()
+            self.pool[thread] = supervisor.state
         return supervisor
 
     def __enter__(self):
         self.supervisor = self._supervisor()
         try:
-            self.supervisor.send(self.spec)
+            self.supervisor.run(self.spec)
             started = self.supervisor.answer(self.cancelled, self.deadline)
             if "error" in started:
                 raise SupervisorFailed(started["error"])
@@ -199,7 +227,7 @@ class Supervised:
 
     def _finish(self, op):
         try:
-            self.supervisor.send({"op": op})
+            self.supervisor.send({"op": op, "id": self.supervisor.task})
         except SupervisorFailed:
             self._discard()
             return
@@ -207,7 +235,7 @@ class Supervised:
             self.supervisor.close()
 
     def _discard(self):
-        if self.pool is not None and self.pool.get(threading.get_ident()) is self.supervisor:
+        if self.pool is not None and self.pool.get(threading.get_ident()) is self.supervisor.state:
             del self.pool[threading.get_ident()]
         self.supervisor.close()
 

@@ -193,8 +193,8 @@ def tables_of(page):
 
 
 def processes_of(tmp, task_only=False):
-    """The live processes whose TMPDIR is `tmp` (all of a runner's, or with task_only the task
-    processes and their supervisors a worker started)."""
+    """The live processes whose TMPDIR is `tmp` (all of a runner's, or with task_only the tasks'
+    engine processes a worker started: not the worker nor its threads' idle supervisors)."""
     marker = ("TMPDIR=%s\0" % tmp).encode()
     found = []
     for pid in os.listdir("/proc"):
@@ -211,7 +211,7 @@ def processes_of(tmp, task_only=False):
                 command = f.read()
         except OSError:
             continue
-        if task_only and not any(name in command for name in (b"work_precision\0", b"cart_simulate\0", b"-I\0-S\0-c\0")):
+        if task_only and not any(name in command for name in (b"work_precision\0", b"cart_simulate\0")):
             continue
         found.append((int(pid), command.replace(b"\0", b" ")[:120].decode(errors="replace")))
     return found
@@ -233,7 +233,7 @@ def wait_until(condition, limit):
 def wait_for_task_processes(tmp, count, runner=None):
     """Until `count` work_precision/cart_simulate processes run with TMPDIR `tmp`."""
     def running():
-        return len([p for p in processes_of(tmp, task_only=True) if "work_precision " in p[1] or "cart_simulate " in p[1]])
+        return len(processes_of(tmp, task_only=True))
     ok = wait_until(lambda: running() >= count or (runner is not None and runner.poll() is not None), RUN_LIMIT)
     return ok and running() >= count
 
@@ -555,7 +555,7 @@ experiments:
                                                         "--scheduler", cluster.address),
                                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
                 self.assertTrue(wait_until(lambda: sum(len(processes_of(t, task_only=True)) for t in cluster.tmp.values())
-                                           >= 4 or runner.poll() is not None, RUN_LIMIT))  # a supervisor and its process each
+                                           >= 2 or runner.poll() is not None, RUN_LIMIT))  # a task on each worker
                 runner.send_signal(number)
                 stopped = time.monotonic()
                 self.assertTrue(wait_until(lambda: not cluster.task_leftovers(), STOPPED),

@@ -12,7 +12,7 @@ import uuid
 
 import pytest
 
-from birkhoff_cart_study.task_runner import Cancelled, Supervised, SupervisorFailed, run_task
+from birkhoff_cart_study.task_runner import Cancelled, Supervised, SupervisorFailed, SupervisorProcess, run_task
 from conftest import REPOSITORY
 
 SETTLE = 2.0  # [s] after which nothing of a stopped task may be left
@@ -123,7 +123,7 @@ def test_a_worker_thread_reuses_its_supervisor_and_a_cancelled_task_leaves_it_us
     for _ in range(3):
         with Supervised(["/bin/sh", "-c", "exit 0"], {}, 10.0, pool=pool) as process:
             assert process.status == 0
-        pids.append(pool[threading.get_ident()].process.pid)
+        pids.append(pool[threading.get_ident()]["process"].pid)
     assert len(set(pids)) == 1  # one supervisor process for the thread's tasks
     command, marker = marked_sleeper()
     cancel_at = time.monotonic() + 0.3
@@ -133,10 +133,10 @@ def test_a_worker_thread_reuses_its_supervisor_and_a_cancelled_task_leaves_it_us
     assert wait_until(lambda: not processes_with(marker) and not task_directories(tmp), 1.0)
     with Supervised(["/bin/sh", "-c", "exit 7"], {}, 10.0, pool=pool) as process:
         assert process.status == 7
-    assert pool[threading.get_ident()].process.pid == pids[0]
+    assert pool[threading.get_ident()]["process"].pid == pids[0]
     with pytest.raises(SupervisorFailed, match="cannot start /nonexistent/engine"):
         with Supervised(["/nonexistent/engine"], {}, 10.0, pool=pool):
             pass
     assert not task_directories(tmp)
-    for supervisor in pool.values():
-        supervisor.close()
+    for state in pool.values():
+        SupervisorProcess(state).close()
