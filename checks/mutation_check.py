@@ -38,7 +38,10 @@ class Mutation:
         self.path = path          # file, relative to the repository
         self.original = original  # text that must occur exactly once
         self.mutated = mutated    # its replacement
-        self.tests = tests        # [(test target, gtest filter)]
+        self.tests = tests        # [(test target, gtest filter)], or [("pytest:FILE", -k expression)]
+
+
+PYTEST = "pytest:"  # a study-runner test: pytest on the scratch copy's test/python/FILE, selected with -k
 
 
 TRAJECTORY = "trajectory_vs_independent_model_test"
@@ -202,6 +205,22 @@ MUTATIONS = [
         'append_value_field(out, "chunk_count", static_cast<std::uint32_t>(chunks_.size() - 1));',
         [("bag_file_writer_test", "*")],
     ),
+    Mutation(
+        "reference_judges_unresolved_goal",
+        "a study's reference judges goals it does not resolve (its check disagrees by more than a tenth of them)",
+        "src/birkhoff_cart_study/references.py",
+        "if RESOLUTION * spread > goal:",
+        "if RESOLUTION * spread > goal * 1e30:",
+        [(PYTEST + "test_study_outcomes.py", "resolves_a_goal or unresolved_reference")],
+    ),
+    Mutation(
+        "cli_csv_fixed_columns",
+        "the CLI contract's CSV check expects 14 or 15 columns instead of the header's own list",
+        "src/birkhoff_cart_study/cli_contract.py",
+        "if len(fields) != len(header):",
+        "if len(fields) not in (14, 15):",
+        [(PYTEST + "test_study_outcomes.py", "own_columns")],
+    ),
 ]
 
 
@@ -255,12 +274,18 @@ def require_scratch_library(build: pathlib.Path, binary: pathlib.Path):
 
 def build_and_run(build: pathlib.Path, tests, log):
     """Builds the targets of `tests` and runs each; returns (built, [failing tests], [passing tests])."""
-    targets = sorted({target for target, _ in tests})
-    status, output = run(["make", "-C", str(build), "-j2", *targets], log=log)
+    targets = sorted({target for target, _ in tests if not target.startswith(PYTEST)})
+    status, output = run(["make", "-C", str(build), "-j2", *targets], log=log) if targets else (0, "")
     if status != 0:
         return False, [], []
     failing, passing = [], []
     for target, gtest_filter in tests:
+        if target.startswith(PYTEST):
+            test_file = build.parent / "src/birkhoff_cart/test/python" / target[len(PYTEST):]
+            status, output = run(["/usr/bin/python3", "-m", "pytest", "-q", "-p", "no:cacheprovider", str(test_file),
+                                  "-k", gtest_filter], log=log)
+            (failing if status != 0 else passing).append(f"{target} -k '{gtest_filter}'")
+            continue
         binary = find_binary(build, target)
         require_scratch_library(build, binary)
         status, output = run([str(binary), f"--gtest_filter={gtest_filter}"], log=log)

@@ -5,6 +5,12 @@
 //                 [--position-tolerance M] [--on-accuracy-error fail|warn] [--random-scene SEED:K]
 //                 --output FILE.csv   (also --option=value)
 //   cart_simulate --help | -h | --version
+//   cart_simulate --list-integrators [--json]
+//
+// --list-integrators prints the registry's table (as --help shows it), or with --json one JSON
+// object: {"integrators": [{"name", "order", "symmetric", "reversible", "vector_stages", "kind",
+// "takes_tolerance", "description"}, ...] in the registry's order, "birkhoffian_forms": [...],
+// "step_controls": [...]} (the study runner reads it: src/birkhoff_cart_study/registry.py).
 //
 // Columns: t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,local_error_estimate (SI
 // units; energy is T* [J], p2 the front axle's yaw momentum [kg·m²/s], local_error_estimate the
@@ -98,6 +104,64 @@ std::string integrator_table() {
   return table;
 }
 
+/// `text` as a JSON string (quotes, backslashes and control characters escaped).
+std::string json_quoted(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\u%04x", static_cast<unsigned>(c));
+      out += escaped;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+std::string json_list(const std::vector<std::string>& names) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < names.size(); ++i) out += (i ? ", " : "") + json_quoted(names[i]);
+  return out + "]";
+}
+
+/// The registry, the Birkhoffian forms and the step controls as one JSON object (--list-integrators --json).
+std::string integrator_listing_json() {
+  std::string out = "{\"integrators\": [";
+  const std::vector<birkhoff_cart::IntegratorEntry>& members = birkhoff_cart::integrator_registry();
+  for (std::size_t i = 0; i < members.size(); ++i) {
+    const birkhoff_cart::IntegratorEntry& member = members[i];
+    out += std::string(i ? ",\n  " : "\n  ") + "{\"name\": " + json_quoted(member.name) +
+           ", \"order\": " + std::to_string(member.order) + ", \"symmetric\": " + (member.symmetric ? "true" : "false") +
+           ", \"reversible\": " + (member.reversible() ? "true" : "false") +
+           ", \"vector_stages\": " + (member.vector_stages ? "true" : "false") +
+           ", \"kind\": " + json_quoted(birkhoff_cart::to_string(member.kind)) +
+           ", \"takes_tolerance\": " + (member.takes_tolerance() ? "true" : "false") +
+           ", \"description\": " + json_quoted(member.description) + "}";
+  }
+  return out + "],\n \"birkhoffian_forms\": " + json_list(birkhoff_cart::birkhoffian_form_names()) +
+         ",\n \"step_controls\": " + json_list(birkhoff_cart::step_control_names()) + "}\n";
+}
+
+/// --list-integrators [--json] (alone on the command line): the registry as a table or as JSON.
+/// Returns the exit status, or -1 when the command line does not ask for the listing.
+int list_integrators_if_asked(int argc, char** argv) {
+  if (argc < 2 || std::strcmp(argv[1], "--list-integrators") != 0) return -1;
+  if (argc == 2) {
+    std::fputs(integrator_table().c_str(), stdout);
+    return 0;
+  }
+  if (argc == 3 && std::strcmp(argv[2], "--json") == 0) {
+    std::fputs(integrator_listing_json().c_str(), stdout);
+    return 0;
+  }
+  std::fprintf(stderr, "cart_simulate: --list-integrators takes only --json, got '%s'\n", argv[2]);
+  return kExitUsage;
+}
+
 std::string usage() {
   using birkhoff_cart::StepControl;
   const std::string fixed = birkhoff_cart::to_string(StepControl::kFixed);
@@ -109,6 +173,7 @@ std::string usage() {
          "] [--position-tolerance M]\n"
          "                     [--on-accuracy-error fail|warn] [--random-scene SEED:K] --output FILE.csv\n"
          "       cart_simulate --help | -h | --version\n"
+         "       cart_simulate --list-integrators [--json]   (the table below; --json: for programs)\n"
          "  --scene FILE            scene YAML (config/scenes/*.yaml); it provides every default\n"
          "  --integrator NAME       a member of the registry (below)\n"
          "  --step H                step size [s], > 0; 1/HZ must be a whole multiple of it (fixed steps only)\n"
@@ -347,6 +412,8 @@ int run(int argc, char** argv) {
     return 0;
   }
   if (birkhoff_cart::print_version_if_asked(argc, argv, "cart_simulate")) return 0;
+  const int listed = list_integrators_if_asked(argc, argv);
+  if (listed >= 0) return listed;
   std::map<std::string, std::string> arguments;
   Scene scene;
   try {
