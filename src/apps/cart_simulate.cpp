@@ -84,21 +84,22 @@ std::string alternatives(const std::vector<std::string>& names, const std::strin
 }
 
 /// The registry's members, one line each: name, order, symmetric, takes the reversible control,
-/// evaluates its stages together, kind, scheme. The members that take --step-control reversible come first.
+/// takes the adaptive control, evaluates its stages together, kind, scheme. The members that take --step-control reversible come first.
 std::string integrator_table() {
   std::vector<birkhoff_cart::IntegratorEntry> members = birkhoff_cart::integrator_registry();
   std::stable_partition(members.begin(), members.end(),
                         [](const birkhoff_cart::IntegratorEntry& member) { return member.reversible(); });
   std::string table =
       "Integrators (--integrator NAME; docs/integrators.md). p: the order; symmetric: a time-symmetric\n"
-      "step map; reversible: takes --step-control reversible; vector: evaluates its stages together,\n"
-      "with one vector sin/cos where the CPU has AVX2.\n"
-      "  NAME                p  symmetric  reversible  vector  kind                     scheme\n";
+      "step map; reversible, adaptive: takes --step-control reversible, adaptive; vector: evaluates its\n"
+      "stages together, with one vector sin/cos where the CPU has AVX2.\n"
+      "  NAME                p  symmetric  reversible  adaptive  vector  kind                     scheme\n";
   for (const birkhoff_cart::IntegratorEntry& member : members) {
-    char line[200];
-    std::snprintf(line, sizeof line, "  %-19s %-2d %-10s %-11s %-7s %-24s %s\n", member.name, member.order,
+    char line[220];
+    std::snprintf(line, sizeof line, "  %-19s %-2d %-10s %-11s %-9s %-7s %-24s %s\n", member.name, member.order,
                   member.symmetric ? "yes" : "no", member.reversible() ? "yes" : "no",
-                  member.vector_stages ? "yes" : "no", birkhoff_cart::to_string(member.kind), member.description);
+                  member.adaptive() ? "yes" : "no", member.vector_stages ? "yes" : "no",
+                  birkhoff_cart::to_string(member.kind), member.description);
     table += line;
   }
   return table;
@@ -137,6 +138,7 @@ std::string integrator_listing_json() {
     out += std::string(i ? ",\n  " : "\n  ") + "{\"name\": " + json_quoted(member.name) +
            ", \"order\": " + std::to_string(member.order) + ", \"symmetric\": " + (member.symmetric ? "true" : "false") +
            ", \"reversible\": " + (member.reversible() ? "true" : "false") +
+           ", \"adaptive\": " + (member.adaptive() ? "true" : "false") +
            ", \"vector_stages\": " + (member.vector_stages ? "true" : "false") +
            ", \"kind\": " + json_quoted(birkhoff_cart::to_string(member.kind)) +
            ", \"takes_tolerance\": " + (member.takes_tolerance() ? "true" : "false") +

@@ -1,5 +1,5 @@
 """The integrator registry as `cart_simulate --list-integrators --json` lists it: the members (name,
-order, symmetric, reversible, kind, whether they read a tolerance), the Birkhoffian forms and the
+order, symmetric, reversible, adaptive, kind, whether they read a tolerance), the Birkhoffian forms and the
 step controls. A study reads it from the binary it runs, so the Python side keeps no second list."""
 import dataclasses
 import json
@@ -13,6 +13,7 @@ class Member:
     order: int
     symmetric: bool
     reversible: bool       # takes --step-control reversible
+    adaptive: bool         # takes --step-control adaptive
     kind: str              # "Birkhoffian collocation", "composition", "explicit RK", "adaptive", ...
     takes_tolerance: bool  # reads --tolerance (its own steps inside h) instead of stepping at h alone
 
@@ -42,7 +43,8 @@ def parse_listing(text):
     try:
         listing = json.loads(text)
         members = tuple(Member(str(m["name"]), int(m["order"]), bool(m["symmetric"]), bool(m["reversible"]),
-                               str(m["kind"]), bool(m["takes_tolerance"])) for m in listing["integrators"])
+                               bool(m["adaptive"]), str(m["kind"]), bool(m["takes_tolerance"]))
+                        for m in listing["integrators"])
         forms = tuple(str(f) for f in listing["birkhoffian_forms"])
         controls = tuple(str(c) for c in listing["step_controls"])
     except (ValueError, KeyError, TypeError) as error:

@@ -144,7 +144,7 @@ def _closest(word, known):
     return " (did you mean '%s'?)" % match[0] if match else ""
 
 
-def _known(names, limit=30):
+def _known(names, limit=20):
     names = [str(n) for n in names]
     shown = ", ".join(names[:limit])
     return shown + (", …" if len(names) > limit else "")

@@ -153,10 +153,14 @@ void Simulation::take_step(double h, double next_time) {
   ++steps_taken_;
 }
 
+bool Simulation::takes_own_steps() const {
+  return scene_.integrator.step_control != StepControl::kFixed || integrator_entry(scene_.integrator.name).takes_tolerance();
+}
+
 void Simulation::advance_output_to(double time) {
-  if (!controlled()) {
-    throw std::logic_error("scene '" + scene_.name + "': advance_output_to() is for a step control (adaptive or "
-                           "reversible); " + scene_.integrator.name + " steps at fixed steps of h");
+  if (!takes_own_steps()) {
+    throw std::logic_error("scene '" + scene_.name + "': advance_output_to() is for a member with its own steps (a "
+                           "step control, or dopri5); " + scene_.integrator.name + " steps at fixed steps of h");
   }
   const double end = end_time();
   if (!std::isfinite(time) || !(time > state_.time) || time > end) {

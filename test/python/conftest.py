@@ -19,6 +19,7 @@ SCENE_DIR = os.path.join(REPOSITORY, "config", "scenes")
 LISTING = {
     "integrators": [
         {"name": name, "order": order, "symmetric": symmetric, "reversible": reversible, "vector_stages": False,
+         "adaptive": kind in ("Birkhoffian collocation", "composition", "adaptive"),
          "kind": kind, "takes_tolerance": kind == "adaptive", "description": name}
         for name, order, symmetric, reversible, kind in (
             ("birkhoff2", 2, True, True, "Birkhoffian collocation"), ("birkhoff4", 4, True, True, "composition"),
@@ -30,7 +31,7 @@ LISTING = {
             ("birkhoff4_suzuki", 4, True, True, "composition"), ("birkhoff6_kahan_li", 6, True, True, "composition"),
             ("birkhoff8_kahan_li", 8, True, True, "composition"))],
     "birkhoffian_forms": ["autonomous", "paper"],
-    "step_controls": ["fixed", "reversible"]}
+    "step_controls": ["fixed", "reversible", "adaptive"]}
 
 
 @pytest.fixture

@@ -172,7 +172,8 @@ MALFORMED = [
     ("a scene name with a semicolon", replaced(WORK_PRECISION, "scene: paper_special", "scene: 'paper;ls'"),
      "key 'experiments[1].scene': must be a shipped scene's name or the path of a scene file"),
     ("a misspelt step control", replaced(CLI_RUNS, "step_control: reversible", "step_control: reversibel"),
-     "key 'experiments[0].step_control': must be 'fixed' or 'reversible', got 'reversibel' (did you mean 'reversible'?)"),
+     "key 'experiments[0].step_control': must be 'fixed', 'reversible' or 'adaptive', got 'reversibel' "
+     "(did you mean 'reversible'?)"),
     ("reversible control for rk4", replaced(CLI_RUNS, "[birkhoff_gauss4, birkhoff_gauss8]", "[birkhoff_gauss4, rk4]"),
      "key 'experiments[0].integrators[1]': rk4 does not take step_control reversible"),
     ("reversible control without tolerances", replaced(CLI_RUNS, "    tolerances: [1.0e-4, 1.0e-6]\n", ""),

@@ -86,16 +86,17 @@ class Simulation {
   /// limits of step_schedule.h.
   void restart_from(const CartState& initial_state);
 
-  /// Under a step control (integrator.step_control adaptive or reversible): the state at `time` [s],
+  /// For a member with its own steps (integrator.step_control adaptive or reversible; dopri5, one
+  /// run over the whole run): the state at `time` [s],
   /// any instant after the current one up to end_time(), however far (the control's own steps, and
   /// its dense output between them; the run's end and land_on() instants exactly). The output grid
   /// of such a run need not be a multiple of step_size(). After it, step() and step_on_schedule()
   /// refuse (the run left their grid); at_end() is true once `time` is end_time(). Throws
-  /// std::logic_error for a fixed-step member, std::invalid_argument for a time not ahead or past
+  /// std::logic_error for a member at fixed steps, std::invalid_argument for a time not ahead or past
   /// the end, StepError as step().
   void advance_output_to(double time);
-  /// Is this run under a step control (adaptive or reversible)?
-  bool controlled() const { return scene_.integrator.step_control != StepControl::kFixed; }
+  /// Does this run's member take its own steps (a step control; dopri5)?
+  bool takes_own_steps() const;
   /// `observer` is called with the state after every accepted step of a step control's own grid
   /// (not for fixed-step members). Kept across reset() and restart_from(); an empty function stops it.
   void observe_grid(CartStepper::GridObserver observer);

@@ -83,9 +83,9 @@ inline RunErrors run_simulation(const BenchScene& bench, Simulation& sim, std::u
   return errors;
 }
 
-/// A run under a step control: from checkpoint to checkpoint (each one landed on exactly), the
-/// residuals sampled after every accepted step of the control's grid, as for odeint's controlled
-/// peers (no dense output in between: the control's cost alone).
+/// A run with its own steps (a step control, dopri5): from checkpoint to checkpoint (each one landed
+/// on exactly), the residuals sampled after every accepted step of its grid, as for odeint's
+/// controlled peers (no dense output in between: the method's cost alone).
 inline RunErrors run_controlled(const BenchScene& bench, Simulation& sim) {
   RunErrors errors;
   errors.energy_scale = sim.diagnostics().energy;
@@ -131,7 +131,8 @@ inline RunRecord measure_ours(const BenchScene& bench, const std::string& method
     record.step_size = h;
   }
   const std::vector<std::uint64_t> checkpoints = checkpoint_steps(bench, steps);
-  const bool controlled = parse_our_method(method).control != StepControl::kFixed;
+  // Its own steps (a step control, or dopri5's one run): measured from checkpoint to checkpoint.
+  const bool controlled = adaptive;
   try {
     StepStatistics statistics;
     Simulation sim(configured(bench.scene, method, h, tolerance));  // built outside the timed region

@@ -111,13 +111,14 @@ def _random_run_tasks(path, where, experiment, doc, context):
 def _product_tasks(path, where, experiment, doc, context):
     registry, scene_dir = context["registry"], context["scene_dir"]
     control = experiment.get("step_control", "fixed")
-    if control == "reversible":
+    if control != "fixed":
         if "tolerances" not in experiment:
-            s.refuse(path, where + ("tolerances",), "required with step_control: reversible (the position errors [m])")
+            s.refuse(path, where + ("tolerances",), "required with step_control: %s (the position errors [m])" % control)
+        takes = (lambda m: m.reversible) if control == "reversible" else (lambda m: m.adaptive)
         for j, name in enumerate(experiment["integrators"]):
-            if not registry.member(name).reversible:
-                s.refuse(path, where + ("integrators", j), "%s does not take step_control reversible (those that do: %s)"
-                         % (name, ", ".join(m.name for m in registry.members if m.reversible)))
+            if not takes(registry.member(name)):
+                s.refuse(path, where + ("integrators", j), "%s does not take step_control %s (those that do: %s)"
+                         % (name, control, ", ".join(m.name for m in registry.members if takes(m))))
     reference = experiment.get("reference")
     end_only = experiment.get("end_only", False)
     tasks = []

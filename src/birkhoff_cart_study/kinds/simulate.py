@@ -26,12 +26,15 @@ def wire(task, bin_dir):
         text = with_start_time(text, settings["start_time"])
     argv = [os.path.join(bin_dir, "cart_simulate"), "--scene", task.scene, "--integrator", settings["method"],
             "--output", "out.csv", "--quiet"]
-    # A study's `tolerances` are dopri5's local tolerance [-], or with step_control: reversible the
-    # position error [m] the control aims at (cart_simulate's --position-tolerance).
+    # A study's `tolerances` are dopri5's local tolerance [-], or under a step control (reversible,
+    # adaptive) the position error [m] the control aims at (cart_simulate's --position-tolerance);
+    # under a step control the rows come at the output rate, and --step is the fixed-step members'.
+    controlled = settings.get("step_control", "fixed") != "fixed"
     if "tolerance" in settings:
-        argv += ["--position-tolerance" if settings.get("step_control") == "reversible" else "--tolerance",
-                 repr(settings["tolerance"])]
+        argv += ["--position-tolerance" if controlled else "--tolerance", repr(settings["tolerance"])]
     for key, option in OPTIONS:
+        if key == "step" and controlled:
+            continue
         if key in settings:
             argv += [option, settings[key] if isinstance(settings[key], str) else repr(settings[key])]
     if settings.get("step_control", "fixed") != "fixed":

@@ -56,9 +56,16 @@ RUN_SETTINGS = {
 
 
 def methods(registry):
-    """Every method a run may name: the registry's members, then Boost.Odeint's peers."""
+    """Every method a run may name: the registry's members, Boost.Odeint's peers, then each member
+    under the step controls it takes (NAME_adaptive, NAME_reversible: their own steps for a position
+    tolerance, swept as `tolerances`)."""
     known = {m.name: Method(m.name, True, m.takes_tolerance, m.reversible) for m in registry.members}
     known.update({name: Method(name, False, adaptive, False) for name, adaptive in ODEINT_PEERS.items()})
+    for m in registry.members:  # last, so that a refusal lists the plain names first
+        for control, offered in (("adaptive", m.adaptive), ("reversible", m.reversible)):
+            if offered:
+                name = "%s_%s" % (m.name, control)
+                known[name] = Method(name, True, True, False)
     return known
 
 
