@@ -116,6 +116,8 @@ def test_cli_runs_expand_the_product_its_reference_and_random_runs(registry, stu
     assert one.settings["step"] == one.settings["output_rate"] ** -1  # end_only: one output step
     argv = kinds.cli_runs.wire(one, "/b")["argv"]
     assert argv[argv.index("--step-control") + 1] == "reversible" and "--position-tolerance" in argv
+    reference_argv = kinds.cli_runs.wire(free[0], "/b")["argv"]  # a scene may set its own control
+    assert reference_argv[reference_argv.index("--step-control") + 1] == "fixed"
     random = [t for t in tasks if t.label == "random"]
     assert len(random) == 5 and all(t.settings["expect"] == "finish_or_refuse" for t in random)
     wire = kinds.cli_runs.wire(random[0], "/b")

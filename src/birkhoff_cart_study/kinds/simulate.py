@@ -37,8 +37,9 @@ def wire(task, bin_dir):
             continue
         if key in settings:
             argv += [option, settings[key] if isinstance(settings[key], str) else repr(settings[key])]
-    if settings.get("step_control", "fixed") != "fixed":
-        argv += ["--step-control", settings["step_control"]]
+    # Always named: a scene may set its own control (very_stiff_hinge.yaml is adaptive), and a
+    # fixed-step reference run on it must say fixed.
+    argv += ["--step-control", settings.get("step_control", "fixed")]
     return dict(task.wire(), argv=argv, files={task.scene: text})
 
 
