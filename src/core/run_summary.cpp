@@ -23,11 +23,11 @@ std::string step_control_summary(const IntegratorSettings& settings, const StepS
                   settings.position_tolerance);
   } else if (settings.step_control == StepControl::kReversible) {
     std::snprintf(text, sizeof text,
-                  "reversible step control: position tolerance %.3g m, eps = %.4g rad (pilot order %.2g), %llu internal steps "
-                  "from %.3g s to %.3g s",
-                  settings.position_tolerance, statistics.control_fictive_step, statistics.control_observed_order,
+                  "reversible step control: position tolerance %.3g m, eps = %.4g rad, %llu internal steps "
+                  "from %.3g s to %.3g s, %llu restarts with a smaller eps",
+                  settings.position_tolerance, statistics.control_fictive_step,
                   static_cast<unsigned long long>(statistics.internal_steps), statistics.internal_step_min,
-                  statistics.internal_step_max);
+                  statistics.internal_step_max, static_cast<unsigned long long>(statistics.rejected_steps));
   } else {
     std::snprintf(text, sizeof text,
                   "adaptive step control: position tolerance %.3g m, %llu internal steps from %.3g s to %.3g s, "

@@ -18,9 +18,8 @@ struct StepStatistics {
   std::uint64_t internal_steps = 0;                                          ///< grid steps taken
   double internal_step_min = std::numeric_limits<double>::infinity();        ///< smallest |h| [s]
   double internal_step_max = 0.0;                                            ///< largest |h| [s]
-  std::uint64_t rejected_steps = 0;  ///< attempts an error-per-step control rejected (adaptive_step_control.h)
+  std::uint64_t rejected_steps = 0;  ///< attempts the adaptive control rejected (adaptive_step_control.h); the reversible control's restarts with a smaller ε
   double control_fictive_step = std::numeric_limits<double>::quiet_NaN();    ///< the reversible control's ε [rad]
-  double control_observed_order = std::numeric_limits<double>::quiet_NaN();  ///< order its pilots showed [-]
 
   // The local error estimate (docs/accuracy.md): per step, the weighted max-norm
   //   ê = maxᵢ |x̂ᵢ − xᵢ| / max(1, |xᵢ(tₖ)|)

@@ -168,6 +168,9 @@ def _ok(row):
     return row is not None and row.get("outcome") == "ok" and (row.get("result") or {}).get("x") is not None
 
 
+WORK_PAIR = (1e-3, 1e-7)  # [m]: the loose and the tight tolerance whose work the tables compare
+
+
 def reference_tables(rows):
     """(markdown lines, unresolved): per experiment and scene judged against its reference, the final
     position error / tolerance of each member and tolerance; 'unresolved' (no ratio, no verdict)
@@ -177,6 +180,7 @@ def reference_tables(rows):
     out, unresolved = [], []
     within = total = 0
     worst = 0.0
+    falls = compared = 0  # members whose work at the loose tolerance is ≤ 1/4 of it at the tight one
     for label, scene in sorted({(r.get("label"), r.get("scene")) for r in judged}):
         refs = {r.get("role"): r for r in simulate_rows if r.get("label") == label and r.get("scene") == scene
                 and r.get("role")}
@@ -193,9 +197,11 @@ def reference_tables(rows):
                     label, scene, ref.get("method"), check["step"] * 2,
                     "to %.2g m: it resolves tolerances ≥ %.2g m" % (spread, RESOLUTION * spread) if spread > 0
                     else "to the last digit: it resolves every tolerance"), "",
-                "| member | " + " | ".join("%g" % t for t in tolerances) + " |", "|---|" + "---|" * len(tolerances)]
+                "| member | " + " | ".join("%g" % t for t in tolerances) + " | work %g m / %g m |" % WORK_PAIR,
+                "|---|" + "---|" * (len(tolerances) + 1)]
         for method in sorted({str(r.get("method")) for r in runs}):
             cells = []
+            work = {}
             for t in tolerances:
                 run = next((r for r in runs if str(r.get("method")) == method and r.get("tolerance") == t), None)
                 if run is None or not _ok(run):
@@ -211,7 +217,15 @@ def reference_tables(rows):
                 within += ratio <= 10.0
                 worst = max(worst, ratio)
                 rhs = run["result"].get("rhs_evaluations")
+                work[t] = rhs
                 cells.append("%.2g (%s rhs)" % (ratio, rhs if rhs is not None else "?"))
+            loose, tight = (work.get(t) for t in WORK_PAIR)
+            if loose and tight:
+                compared += 1
+                falls += loose <= 0.25 * tight
+                cells.append("%.2f" % (loose / tight))
+            else:
+                cells.append("—")
             out.append("| `%s` | %s |" % (method, " | ".join(cells)))
         out.append("")
     if not out:
@@ -219,7 +233,9 @@ def reference_tables(rows):
     head = ["## Against the reference", "",
             "Final position error / tolerance (and rhs evaluations): %d of %d judged runs within 10× of the tolerance, "
             "worst %.3g; %d without a verdict ('unresolved': the reference and its check differ by more than a "
-            "tenth of that tolerance)." % (within, total, worst, len(unresolved)), ""]
+            "tenth of that tolerance). The last column is the work (rhs evaluations) at %g m over the work at %g m: "
+            "%d of %d members at or below 1/4." % (within, total, worst, len(unresolved), WORK_PAIR[0], WORK_PAIR[1],
+                                                   falls, compared), ""]
     return head + out, unresolved
 
 
