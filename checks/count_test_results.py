@@ -50,7 +50,9 @@ def expected_from_sources(repo: pathlib.Path):
     for launch in sorted((repo / "test/integration").glob("*.test")):
         names.append((f"rostest-test_integration_{launch.stem}.xml", launch))
     for module in sorted((repo / "test/python").glob("test_*.py")):
-        names.append((f"pytest-{module.stem}.xml", module))
+        # the study runner's modules run as one pytest, the others one result file each
+        names.append(("pytest-study_units.xml" if module.stem.startswith("test_study_") else f"pytest-{module.stem}.xml",
+                      module))
     return names
 
 

@@ -38,7 +38,10 @@ class Mutation:
         self.path = path          # file, relative to the repository
         self.original = original  # text that must occur exactly once
         self.mutated = mutated    # its replacement
-        self.tests = tests        # [(test target, gtest filter)]
+        self.tests = tests        # [(test target, gtest filter)], or [("pytest:FILE", -k expression)]
+
+
+PYTEST = "pytest:"  # a study-runner test: pytest on the scratch copy's test/python/FILE, selected with -k
 
 
 TRAJECTORY = "trajectory_vs_independent_model_test"
@@ -97,7 +100,7 @@ MUTATIONS = [
     Mutation(
         "passive_rates_at_first_stage",
         "the passive coordinates (x, y, θ, φ) are integrated with every stage's rate taken at the first stage",
-        "include/birkhoff_cart/core/integrators/gauss_collocation.h",
+        "include/birkhoff_cart/core/integrators/passive_quadrature.h",
         "passive_rates[j] = passive_coordinate_rates(system, stage_points[j], passive_stages[j], S(stage_times[j]));",
         "passive_rates[j] = passive_coordinate_rates(system, stage_points[0], passive_stages[0], S(stage_times[0]));",
         [(TRAJECTORY, "*"), ("integrator_contract_test", "*")],
@@ -114,9 +117,9 @@ MUTATIONS = [
         "compensated_summation_dropped",
         "the compensated (TwoSum) state update silently falls back to plain summation",
         "include/birkhoff_cart/core/integrators/gauss_collocation.h",
-        "const bool compensate = settings_.compensated && collocation_detail::LinearChart<System>::value;\n"
+        "const bool compensate = settings_.compensated && system_traits::kDarbouxChartIsLinear<System>;\n"
         "    if (!compensate) {",
-        "const bool compensate = false && settings_.compensated && collocation_detail::LinearChart<System>::value;\n"
+        "const bool compensate = false && settings_.compensated && system_traits::kDarbouxChartIsLinear<System>;\n"
         "    if (!compensate) {",
         [("gauss_collocation_test", "*")],
     ),
@@ -129,12 +132,30 @@ MUTATIONS = [
         [("gauss_collocation_test", "*"), ("long_run_test", "*")],
     ),
     Mutation(
-        "reversible_rho_update",
-        "the reversible step control's second half-update of ρ is dropped (the map is no longer symmetric)",
-        "include/birkhoff_cart/core/integrators/reversible_step_control.h",
-        "rho_ = rho_half + 0.5 * epsilon * log_rate_;",
-        "rho_ = rho_half;",
+        "time_transform_passive_rates",
+        "the time transformation scales ż by 1/σ but not the passive rates ẏ (positions advance in fictive time)",
+        "include/birkhoff_cart/core/integrators/time_transformed_system.h",
+        "passive_coordinate_rates(*system_, z, BasePassive<S>(y.template head<System::kPassiveDimension>()), t) *\n"
+        "        inverse_density;",
+        "passive_coordinate_rates(*system_, z, BasePassive<S>(y.template head<System::kPassiveDimension>()), t) *\n"
+        "        S(1.0);",
         [("reversible_step_control_test", "*")],
+    ),
+    Mutation(
+        "adaptive_accepts_every_step",
+        "the error-per-step control accepts a step whatever its estimate says",
+        "include/birkhoff_cart/core/integrators/adaptive_step_control.h",
+        "if (!solved || !finite_point() || !(ratio <= 1.0) ||",
+        "if (!solved || !finite_point() || !(ratio <= 1e30) ||",
+        [("adaptive_step_control_test", "*")],
+    ),
+    Mutation(
+        "compensated_remainder_counted_twice",
+        "the compensated update counts the carried remainder once more for each stage weight (odd s)",
+        "include/birkhoff_cart/core/integrators/gauss_collocation.h",
+        "W increment = S(tableau.remainder_weight) * w_remainder;",
+        "W increment = w_remainder;",
+        [("gauss_collocation_test", "*")],
     ),
     Mutation(
         "error_estimate_weights",
@@ -183,6 +204,22 @@ MUTATIONS = [
         'append_value_field(out, "chunk_count", static_cast<std::uint32_t>(chunks_.size()));',
         'append_value_field(out, "chunk_count", static_cast<std::uint32_t>(chunks_.size() - 1));',
         [("bag_file_writer_test", "*")],
+    ),
+    Mutation(
+        "reference_judges_unresolved_goal",
+        "a study's reference judges goals it does not resolve (its check disagrees by more than a tenth of them)",
+        "src/birkhoff_cart_study/references.py",
+        "if RESOLUTION * spread > goal:",
+        "if RESOLUTION * spread > goal * 1e30:",
+        [(PYTEST + "test_study_outcomes.py", "resolves_a_goal or unresolved_reference")],
+    ),
+    Mutation(
+        "cli_csv_fixed_columns",
+        "the CLI contract's CSV check expects 14 or 15 columns instead of the header's own list",
+        "src/birkhoff_cart_study/cli_contract.py",
+        "if len(fields) != len(header):",
+        "if len(fields) not in (14, 15):",
+        [(PYTEST + "test_study_outcomes.py", "own_columns")],
     ),
 ]
 
@@ -237,12 +274,18 @@ def require_scratch_library(build: pathlib.Path, binary: pathlib.Path):
 
 def build_and_run(build: pathlib.Path, tests, log):
     """Builds the targets of `tests` and runs each; returns (built, [failing tests], [passing tests])."""
-    targets = sorted({target for target, _ in tests})
-    status, output = run(["make", "-C", str(build), "-j2", *targets], log=log)
+    targets = sorted({target for target, _ in tests if not target.startswith(PYTEST)})
+    status, output = run(["make", "-C", str(build), "-j2", *targets], log=log) if targets else (0, "")
     if status != 0:
         return False, [], []
     failing, passing = [], []
     for target, gtest_filter in tests:
+        if target.startswith(PYTEST):
+            test_file = build.parent / "src/birkhoff_cart/test/python" / target[len(PYTEST):]
+            status, output = run(["/usr/bin/python3", "-m", "pytest", "-q", "-p", "no:cacheprovider", str(test_file),
+                                  "-k", gtest_filter], log=log)
+            (failing if status != 0 else passing).append(f"{target} -k '{gtest_filter}'")
+            continue
         binary = find_binary(build, target)
         require_scratch_library(build, binary)
         status, output = run([str(binary), f"--gtest_filter={gtest_filter}"], log=log)

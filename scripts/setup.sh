@@ -37,6 +37,8 @@ packages=(
   python3-distributed python3-dask python3-pandas python3-yaml
   # the Python module birkhoff_cart.simulator (docs/python.md) and its tests
   pybind11-dev python3-pybind11 python3-numpy python3-pytest
+  # its study-file schema (python3-jsonschema) and its unit tests (python3-pytest: scripts/run_tests.sh)
+  python3-jsonschema
 )
 missing=()
 for package in "${packages[@]}"; do

@@ -5,6 +5,12 @@
 //                 [--position-tolerance M] [--on-accuracy-error fail|warn] [--random-scene SEED:K]
 //                 --output FILE.csv   (also --option=value)
 //   cart_simulate --help | -h | --version
+//   cart_simulate --list-integrators [--json]
+//
+// --list-integrators prints the registry's table (as --help shows it), or with --json one JSON
+// object: {"integrators": [{"name", "order", "symmetric", "reversible", "vector_stages", "kind",
+// "takes_tolerance", "description"}, ...] in the registry's order, "birkhoffian_forms": [...],
+// "step_controls": [...]} (the study runner reads it: src/birkhoff_cart_study/registry.py).
 //
 // Columns: t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,local_error_estimate (SI
 // units; energy is T* [J], p2 the front axle's yaw momentum [kg·m²/s], local_error_estimate the
@@ -78,45 +84,109 @@ std::string alternatives(const std::vector<std::string>& names, const std::strin
 }
 
 /// The registry's members, one line each: name, order, symmetric, takes the reversible control,
-/// evaluates its stages together, kind, scheme. The members that take --step-control reversible come first.
+/// takes the adaptive control, evaluates its stages together, kind, scheme. The members that take --step-control reversible come first.
 std::string integrator_table() {
   std::vector<birkhoff_cart::IntegratorEntry> members = birkhoff_cart::integrator_registry();
   std::stable_partition(members.begin(), members.end(),
                         [](const birkhoff_cart::IntegratorEntry& member) { return member.reversible(); });
   std::string table =
       "Integrators (--integrator NAME; docs/integrators.md). p: the order; symmetric: a time-symmetric\n"
-      "step map; reversible: takes --step-control reversible; vector: evaluates its stages together,\n"
-      "with one vector sin/cos where the CPU has AVX2.\n"
-      "  NAME                p  symmetric  reversible  vector  kind                     scheme\n";
+      "step map; reversible, adaptive: takes --step-control reversible, adaptive; vector: evaluates its\n"
+      "stages together, with one vector sin/cos where the CPU has AVX2.\n"
+      "  NAME                p  symmetric  reversible  adaptive  vector  kind                     scheme\n";
   for (const birkhoff_cart::IntegratorEntry& member : members) {
-    char line[200];
-    std::snprintf(line, sizeof line, "  %-19s %-2d %-10s %-11s %-7s %-24s %s\n", member.name, member.order,
+    char line[220];
+    std::snprintf(line, sizeof line, "  %-19s %-2d %-10s %-11s %-9s %-7s %-24s %s\n", member.name, member.order,
                   member.symmetric ? "yes" : "no", member.reversible() ? "yes" : "no",
-                  member.vector_stages ? "yes" : "no", birkhoff_cart::to_string(member.kind), member.description);
+                  member.adaptive() ? "yes" : "no", member.vector_stages ? "yes" : "no",
+                  birkhoff_cart::to_string(member.kind), member.description);
     table += line;
   }
   return table;
+}
+
+/// `text` as a JSON string (quotes, backslashes and control characters escaped).
+std::string json_quoted(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\u%04x", static_cast<unsigned>(c));
+      out += escaped;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+std::string json_list(const std::vector<std::string>& names) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < names.size(); ++i) out += (i ? ", " : "") + json_quoted(names[i]);
+  return out + "]";
+}
+
+/// The registry, the Birkhoffian forms and the step controls as one JSON object (--list-integrators --json).
+std::string integrator_listing_json() {
+  std::string out = "{\"integrators\": [";
+  const std::vector<birkhoff_cart::IntegratorEntry>& members = birkhoff_cart::integrator_registry();
+  for (std::size_t i = 0; i < members.size(); ++i) {
+    const birkhoff_cart::IntegratorEntry& member = members[i];
+    out += std::string(i ? ",\n  " : "\n  ") + "{\"name\": " + json_quoted(member.name) +
+           ", \"order\": " + std::to_string(member.order) + ", \"symmetric\": " + (member.symmetric ? "true" : "false") +
+           ", \"reversible\": " + (member.reversible() ? "true" : "false") +
+           ", \"adaptive\": " + (member.adaptive() ? "true" : "false") +
+           ", \"vector_stages\": " + (member.vector_stages ? "true" : "false") +
+           ", \"kind\": " + json_quoted(birkhoff_cart::to_string(member.kind)) +
+           ", \"takes_tolerance\": " + (member.takes_tolerance() ? "true" : "false") +
+           ", \"description\": " + json_quoted(member.description) + "}";
+  }
+  return out + "],\n \"birkhoffian_forms\": " + json_list(birkhoff_cart::birkhoffian_form_names()) +
+         ",\n \"step_controls\": " + json_list(birkhoff_cart::step_control_names()) + "}\n";
+}
+
+/// --list-integrators [--json] (alone on the command line): the registry as a table or as JSON.
+/// Returns the exit status, or -1 when the command line does not ask for the listing.
+int list_integrators_if_asked(int argc, char** argv) {
+  if (argc < 2 || std::strcmp(argv[1], "--list-integrators") != 0) return -1;
+  if (argc == 2) {
+    std::fputs(integrator_table().c_str(), stdout);
+    return 0;
+  }
+  if (argc == 3 && std::strcmp(argv[2], "--json") == 0) {
+    std::fputs(integrator_listing_json().c_str(), stdout);
+    return 0;
+  }
+  std::fprintf(stderr, "cart_simulate: --list-integrators takes only --json, got '%s'\n", argv[2]);
+  return kExitUsage;
 }
 
 std::string usage() {
   using birkhoff_cart::StepControl;
   const std::string fixed = birkhoff_cart::to_string(StepControl::kFixed);
   const std::string reversible = birkhoff_cart::to_string(StepControl::kReversible);
+  const std::string adaptive = birkhoff_cart::to_string(StepControl::kAdaptive);
   return "usage: cart_simulate --scene FILE [--integrator NAME] [--step H] [--tolerance TOL]\n"
          "                     [--duration T] [--output-rate HZ] [--birkhoffian-form F] [--quiet]\n"
          "                     [--step-control " + alternatives(birkhoff_cart::step_control_names(), "|", "|") +
          "] [--position-tolerance M]\n"
          "                     [--on-accuracy-error fail|warn] [--random-scene SEED:K] --output FILE.csv\n"
          "       cart_simulate --help | -h | --version\n"
+         "       cart_simulate --list-integrators [--json]   (the table below; --json: for programs)\n"
          "  --scene FILE            scene YAML (config/scenes/*.yaml); it provides every default\n"
          "  --integrator NAME       a member of the registry (below)\n"
-         "  --step H                step size [s], > 0; 1/HZ must be a whole multiple of it\n"
+         "  --step H                step size [s], > 0; 1/HZ must be a whole multiple of it (fixed steps only)\n"
          "  --tolerance TOL         dopri5's absolute and relative local tolerance [-], >= 10 machine epsilon\n"
          "                          (2.2e-15); refused for the fixed-step members\n"
-         "  --step-control C        " + fixed + " (steps of H) or " + reversible +
-         " (symmetric Birkhoffian members: their own\n"
-         "                          steps for --position-tolerance, H is then the output step; docs/accuracy.md §4)\n"
-         "  --position-tolerance M  " + reversible + " step control: the position error [m] allowed at the horizon\n"
+         "  --step-control C        " + fixed + " (steps of H), " + reversible +
+         " (symmetric Birkhoffian members, free runs) or\n"
+         "                          " + adaptive + " (Birkhoffian members and dopri5, any scene): their own\n"
+         "                          steps for --position-tolerance, rows at any --output-rate (docs/accuracy.md §4)\n"
+         "  --position-tolerance M  " + reversible + " or " + adaptive +
+         " step control: the position error [m] allowed at the horizon\n"
          "  --duration T            simulated time after the start [s], > 0\n"
          "  --output-rate HZ        output rows per simulated second [Hz], > 0\n"
          "  --birkhoffian-form F    " + alternatives(birkhoff_cart::birkhoffian_form_names(), ", ", " or ") + "\n"
@@ -239,23 +309,32 @@ void apply_overrides(const std::map<std::string, std::string>& arguments, Scene&
   }
   // Each tolerance means one thing and is refused where it would be ignored.
   const birkhoff_cart::IntegratorSettings& settings = scene.integrator;
-  const bool reversible = settings.step_control == birkhoff_cart::StepControl::kReversible;
+  const bool controlled = settings.step_control != birkhoff_cart::StepControl::kFixed;
+  const std::string control = birkhoff_cart::to_string(settings.step_control);
   const birkhoff_cart::IntegratorEntry* member = birkhoff_cart::find_integrator(settings.name);
   if (arguments.count("--tolerance") && !(member != nullptr && member->takes_tolerance())) {
     throw UsageError("option --tolerance is dopri5's local tolerance [-]; " + settings.name + " steps at " +
-                     (reversible ? "the reversible step control's steps: give the position error [m] with "
-                                   "--position-tolerance M"
-                                 : "--step H (fixed steps; the symmetric Birkhoffian members choose their own "
-                                   "steps for a position error with --step-control reversible --position-tolerance M)"));
+                     (controlled ? "the " + control + " step control's steps: give the position error [m] with "
+                                                      "--position-tolerance M"
+                                 : std::string("--step H (fixed steps; the Birkhoffian members choose their own "
+                                               "steps for a position error with --step-control adaptive or "
+                                               "reversible --position-tolerance M)")));
   }
-  if (arguments.count("--position-tolerance") && !reversible) {
-    throw UsageError("option --position-tolerance is the position error [m] for --step-control reversible; the run "
-                     "steps at fixed steps of --step H");
+  if (arguments.count("--position-tolerance") && !controlled) {
+    throw UsageError("option --position-tolerance is the position error [m] for --step-control adaptive or "
+                     "reversible; the run steps at fixed steps of --step H");
   }
-  if (reversible && !(settings.position_tolerance > 0.0)) {
-    throw UsageError("option --step-control reversible needs --position-tolerance M (the position error [m] allowed "
-                     "at the horizon)");
+  if (controlled && !(settings.position_tolerance > 0.0)) {
+    throw UsageError("option --step-control " + control +
+                     " needs --position-tolerance M (the position error [m] allowed at the horizon)");
   }
+  if (controlled && arguments.count("--step")) {
+    throw UsageError("option --step is the fixed-step members' step; under --step-control " + control +
+                     " the member chooses its own steps and the rows come at --output-rate HZ");
+  }
+  // Under a step control the output step is the row interval: the rows need not fall on any step
+  // of the member's (its dense output), so the scene's step_size does not constrain them.
+  if (controlled) scene.integrator.step_size = 1.0 / scene.output_rate;
 }
 
 /// The scene key a time limit blames, with the option that may have set it.
@@ -335,6 +414,8 @@ int run(int argc, char** argv) {
     return 0;
   }
   if (birkhoff_cart::print_version_if_asked(argc, argv, "cart_simulate")) return 0;
+  const int listed = list_integrators_if_asked(argc, argv);
+  if (listed >= 0) return listed;
   std::map<std::string, std::string> arguments;
   Scene scene;
   try {

@@ -55,22 +55,30 @@ def with_start_time(scene_text, start):
     return text if replaced == 1 else None
 
 
+# Columns that may be empty in a row (the header names every column: the odometry sensor and the
+# actuators add theirs): the last step's error estimate of an integrator without one.
+OPTIONAL_COLUMNS = {"local_error_estimate"}
+
+
 def check_csv(path, start, end, h, complete):
-    """None if the CSV keeps the contract, else what is wrong with it."""
+    """None if the CSV keeps the contract, else what is wrong with it. Every row has the header's
+    columns (the scene's own list: cart_simulate adds the sensor's and the actuators' columns)."""
     try:
         with open(path) as f:
             lines = f.read().splitlines()
-    except OSError as error:
-        return "no CSV: %s" % error
+    except (OSError, UnicodeDecodeError) as error:
+        return "no CSV: %s" % (getattr(error, "strerror", None) or error)
     if not lines or not lines[0].startswith("t,x,y"):
         return "no header"
+    header = lines[0].split(",")
+    optional = {i for i, name in enumerate(header) if name in OPTIONAL_COLUMNS}
     times = []
     for number, line in enumerate(lines[1:], start=2):
         fields = line.split(",")
-        if len(fields) not in (14, 15):  # 15: local_error_estimate, empty for methods without one
-            return "line %d has %d fields" % (number, len(fields))
+        if len(fields) != len(header):
+            return "line %d has %d fields, the header %d" % (number, len(fields), len(header))
         try:
-            values = [float(v) for v in fields[:14]] + [float(v) for v in fields[14:] if v]
+            values = [float(v) for i, v in enumerate(fields) if v or i not in optional]
         except ValueError:
             return "line %d does not parse" % number
         if complete and not all(math.isfinite(v) for v in values):
@@ -85,6 +93,18 @@ def check_csv(path, start, end, h, complete):
     if complete and end is not None and abs(times[-1] - end) > 1e-9 * h + 4.0 * math.ulp(abs(end)):
         return "last row at %r, not t0 + T = %r" % (times[-1], end)
     return None
+
+
+def error_line(stderr):
+    """The line naming why cart_simulate refused or stopped: the last 'cart_simulate: ' line before
+    the usage text (a bad argument is followed by the usage), progress lines aside; a warning such
+    as the paper form's drift comes before it."""
+    lines = stderr.splitlines()
+    usage = next((i for i, line in enumerate(lines) if line.startswith("usage: ")), len(lines))
+    named = [line for line in lines[:usage] if line.startswith("cart_simulate: ") and "% of scene time" not in line]
+    if named:
+        return named[-1]
+    return lines[usage - 1] if usage else ""
 
 
 def reason_of(line):
@@ -110,13 +130,13 @@ def judge(status, stderr, csv_path, start, duration, h):
     """(outcome, reason) of one run under the contract: outcome "ok" (exit 0, sound CSV),
     "refused" (exit 2–5 with a named reason and a sound partial CSV) or "failed"."""
     end = start + duration if start is not None and duration is not None else None
-    last = stderr.strip().splitlines()[-1] if stderr.strip() else ""
+    last = error_line(stderr)
     if status == 0:
         problem = check_csv(csv_path, start, end, h, complete=True)
         return ("ok", None) if problem is None else ("failed", "exit 0 but " + problem)
     if status in (2, 3, 4, 5):
         if not last.startswith("cart_simulate: ") or "unexpected error" in last:
-            return "failed", "exit %d without a named reason: %r" % (status, last[:200])
+            return "failed", "exit %d without a named reason: %s" % (status, last[:200])
         problem = check_csv(csv_path, start, end, h, complete=status == 5) if status in (4, 5) else None
         if problem is not None:
             return "failed", "exit %d with a broken CSV: %s" % (status, problem)

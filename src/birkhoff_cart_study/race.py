@@ -118,6 +118,17 @@ def describe_crossover(peer, birkhoffian):
     return text
 
 
+def _crossover_cell(peer_runs, birkhoffian_runs, error_floor):
+    """The crossover phrase from the runs whose position error the reference resolves (≥ error_floor)."""
+    if math.isinf(error_floor):
+        return "unresolved"
+    def resolved(runs):
+        return envelope([r for r in runs if _usable(r.get("error")) and r["error"] >= error_floor], "error")
+    text = describe_crossover(resolved(peer_runs), resolved(birkhoffian_runs))
+    clipped = any(_usable(r.get("error")) and r["error"] < error_floor for r in peer_runs + birkhoffian_runs)
+    return text + ("; errors below %.2g m unresolved" % error_floor if clipped else "")
+
+
 def _at_goal(peer, birkhoffian, goal):
     """The ratio of the two envelopes' costs at exactly the goal, as a cell's second number."""
     p, p_how = cost_at(peer, goal)
@@ -127,10 +138,15 @@ def _at_goal(peer, birkhoffian, goal):
     return "at the goal %.2f×" % (p / b)
 
 
-def race(runs, goals, is_birkhoffian):
+def race(runs, goals, is_birkhoffian, unresolved=None, error_floor=0.0):
     """Markdown: the race table (rows: the best Birkhoffian member, then each peer; columns: the
     goals, then the crossover along the position error) and the summary line.
-    goals: [(run key, goal, column title)]; runs carry "method" and "setting" besides their errors."""
+    goals: [(run key, goal, column title)]; runs carry "method" and "setting" besides their errors.
+    unresolved: {goal index: why} of the goals the reference cannot judge: every cell of such a goal
+    says "unresolved", with no run, no ratio and no verdict, and the goal is not counted.
+    error_floor [m]: the smallest position error the reference resolves; the crossover column is
+    drawn from the runs at or above it."""
+    unresolved = unresolved or {}
     birkhoffian = [r for r in runs if is_birkhoffian(r["method"])]
     peers = sorted({r["method"] for r in runs if not is_birkhoffian(r["method"])})
     b_curves = {key: envelope(birkhoffian, key) for key, _, _ in goals}
@@ -138,7 +154,10 @@ def race(runs, goals, is_birkhoffian):
     lines = ["| peer | " + " | ".join(title for _, _, title in goals) + " | crossover (position error) |",
              "|---|" + "---|" * (len(goals) + 1)]
     best = []
-    for key, goal, _ in goals:
+    for index, (key, goal, _) in enumerate(goals):
+        if index in unresolved:
+            best.append("unresolved")
+            continue
         b_run = _cheapest(b_curves[key], goal)
         if b_run is None:
             best.append("none reaches it")
@@ -148,8 +167,12 @@ def race(runs, goals, is_birkhoffian):
                                       "; at the goal %s" % cpu_text(cost) if cost is not None else
                                       "; at the goal: extrapolated" if how == "looser" else ""))
     span = b_curves["error"]
-    lines.append("| *best Birkhoffian* | %s | %s |" % (
-        " | ".join(best), "runs from %s to %s" % (_m(span[0][0]), _m(span[-1][0])) if span else "—"))
+    span_text = "runs from %s to %s" % (_m(span[0][0]), _m(span[-1][0])) if span else "—"
+    if math.isinf(error_floor):
+        span_text = "unresolved"
+    elif span and span[0][0] < error_floor:
+        span_text += "; errors below %.2g m unresolved" % error_floor
+    lines.append("| *best Birkhoffian* | %s | %s |" % (" | ".join(best), span_text))
 
     met_cells = cells = 0
     beaten = {goal_index: [] for goal_index in range(len(goals))}  # the peers the goal is missed against
@@ -157,6 +180,9 @@ def race(runs, goals, is_birkhoffian):
         mine = [r for r in runs if r["method"] == p]
         row = []
         for index, (key, goal, _) in enumerate(goals):
+            if index in unresolved:
+                row.append("unresolved")
+                continue
             curve = envelope(mine, key)
             b_run, p_run = _cheapest(b_curves[key], goal), _cheapest(curve, goal)
             if b_run and p_run:
@@ -178,11 +204,14 @@ def race(runs, goals, is_birkhoffian):
             met_cells += met
             if not met:
                 beaten[index].append((ratio, p))
-        row.append(describe_crossover(envelope(mine, "error"), b_curves["error"]))
+        row.append(_crossover_cell(mine, birkhoffian, error_floor))
         lines.append("| `%s` | %s |" % (p, " | ".join(row)))
 
     verdicts, goals_met, goals_counted, unreached = [], [], 0, []
     for index, (key, goal, title) in enumerate(goals):
+        if index in unresolved:
+            verdicts.append("unresolved: no verdict")
+            continue
         reached_by_b = _cheapest(b_curves[key], goal) is not None
         reached_by_peer = any(_cheapest(envelope([r for r in runs if r["method"] == p], key), goal) for p in peers)
         if not reached_by_b and not reached_by_peer:
@@ -207,6 +236,9 @@ def race(runs, goals, is_birkhoffian):
                    " (%s)" % ", ".join(goals_met) if goals_met else "", met_cells, cells))
     if unreached:
         summary += " No method reaches %s." % ", ".join(unreached)
+    if unresolved:
+        summary += " No verdict for %s: the reference does not resolve %s." % (
+            ", ".join(goals[i][2] for i in sorted(unresolved)), "it" if len(unresolved) == 1 else "them")
     return "\n".join(lines), summary
 
 

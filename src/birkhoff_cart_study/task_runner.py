@@ -1,21 +1,37 @@
 """One task = one process of the batch engine, run on a Dask worker; returns one row (a dict).
 
 This module is what workers execute: it needs only the standard library and the package's
-executables (`bin_dir`, the same path on every worker). The scene travels inside the task, so
-workers need no shared file system."""
+executables (the task's argument list names them by their path, the same on every worker). The
+process runs under its worker thread's supervisor (supervisor.py), a process of its own, started
+once and reused task after task, that outlives the worker and its thread: it enforces the time
+limit, removes the task directory when the row is made, and stops the process and removes its
+directory as soon as the task is cancelled (the runner's SIGINT or SIGTERM, its client gone) or
+the worker is gone, however it ended."""
 import json
 import os
-import re
-import shutil
+import select
 import signal
 import socket
 import subprocess
-import tempfile
+import sys
+import threading
 import time
 
-from .cli_contract import judge
+STDERR_TAIL = 2000         # characters of a failed process's stderr kept in its row
+OUTPUT_CAP = 4 * 2 ** 20   # [bytes] of the process's stdout and stderr read back
+POLL = 0.05                # [s] between looks at the task's cancellation
+SUPERVISOR_GRACE = 30.0    # [s] past the time limit before the supervisor itself is given up on
 
-STDERR_TAIL = 2000  # characters of a failed process's stderr kept in its row
+with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "supervisor.py")) as _source:
+    SUPERVISOR_SOURCE = _source.read()
+
+
+class Cancelled(Exception):
+    """The task was cancelled while its process ran; the process is stopped, its directory gone."""
+
+
+class SupervisorFailed(Exception):
+    """The supervisor could not run the process (or ended without a word)."""
 
 
 def _worker_name():
@@ -26,157 +42,243 @@ def _worker_name():
         return "local"
 
 
-def run_process(command, time_limit, work_dir):
-    """Runs `command` with stdout and stderr to files; returns (exit status, stdout, stderr,
-    CPU seconds of the process, wall seconds, timed_out). Past `time_limit` [s] of wall time the
-    process group is killed. The CPU time is the child's own (wait4's rusage)."""
-    out_path, err_path = os.path.join(work_dir, "stdout"), os.path.join(work_dir, "stderr")
-    with open(out_path, "wb") as out, open(err_path, "wb") as err:
-        start = time.monotonic()
-        process = subprocess.Popen(command, stdout=out, stderr=err, stdin=subprocess.DEVNULL,
-                                   start_new_session=True)
-        timed_out = False
+def dask_task_cancelled():
+    """True when the Dask task this thread runs has been cancelled or released (the runner
+    cancelled it, or its client is gone); False outside a Dask worker."""
+    try:
+        from distributed import get_worker
+        from distributed.worker import thread_state
+        worker = get_worker()
+    except (ImportError, ValueError):
+        return False
+    key = getattr(thread_state, "key", None)
+    if key is None:
+        return False
+    state = worker.state.tasks.get(key)
+    return state is None or state.state in ("cancelled", "released", "forgotten")
+
+
+def _tail(path, cap=OUTPUT_CAP):
+    try:
+        with open(path, "rb") as f:
+            size = os.fstat(f.fileno()).st_size
+            if size > cap:
+                f.seek(size - cap)
+            return f.read().decode(errors="replace")
+    except OSError:
+        return ""
+
+
+class Process:
+    """What the task's process did: exit status, CPU and wall seconds, timed_out, its stdout and
+    stderr, and the task directory where its output files still are (until the row is made)."""
+
+    def __init__(self, report, directory):
+        self.status = report["status"]
+        self.cpu_s = report["cpu_s"]
+        self.wall_s = report["wall_s"]
+        self.timed_out = report["timed_out"]
+        self.directory = directory
+        self.stdout = _tail(os.path.join(directory, "stdout"))
+        self.stderr = _tail(os.path.join(directory, "stderr"))
+
+    def path(self, name):
+        return os.path.join(self.directory, name)
+
+
+class SupervisorProcess:
+    """A running supervisor (supervisor.py) and its command channel: JSON lines both ways.
+
+    Its state is a plain dict (the process, the unread answers, the latest task's id), which a
+    worker keeps across tasks: each task's code arrives by value, with classes of its own, so a
+    worker must not hold objects of an earlier task's classes (their exceptions would not be the
+    ones the later code catches)."""
+
+    def __init__(self, state=None):
+        if state is None:
+            state = {"process": subprocess.Popen([sys.executable, "-I", "-S", "-c", SUPERVISOR_SOURCE],
+                                                 stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                                 start_new_session=True),
+                     "buffer": b"", "task": 0}
+        self.state = state
+        self.process = state["process"]
+
+    @property
+    def task(self):
+        return self.state["task"]
+
+    def alive(self):
+        return self.process.poll() is None
+
+    def send(self, message):
+        try:
+            self.process.stdin.write((json.dumps(message) + "\n").encode())
+            self.process.stdin.flush()
+        except (BrokenPipeError, ValueError):
+            raise SupervisorFailed("the supervisor is gone")
+
+    def run(self, spec):
+        """Sends a task; returns its id (every answer about it carries it)."""
+        self.state["task"] += 1
+        self.send(dict(spec, id=self.task))
+        return self.task
+
+    def answer(self, cancelled, deadline):
+        """The supervisor's next answer about the latest task (a late answer about a cancelled one
+        is skipped); Cancelled when `cancelled()` turns true first."""
         while True:
-            pid, status, usage = os.wait4(process.pid, os.WNOHANG)
-            if pid:
-                break
-            if time.monotonic() - start > time_limit:
-                timed_out = True
-                os.killpg(process.pid, signal.SIGKILL)
-                pid, status, usage = os.wait4(process.pid, 0)
-                break
-            time.sleep(0.02)
-        wall = time.monotonic() - start
-        process.returncode = os.waitstatus_to_exitcode(status)
-    with open(out_path, errors="replace") as f:
-        stdout = f.read()
-    with open(err_path, errors="replace") as f:
-        stderr = f.read()
-    return process.returncode, stdout, stderr, usage.ru_utime + usage.ru_stime, wall, timed_out
+            message = self._line(cancelled, deadline)
+            if message.get("id") == self.task:
+                return message
+
+    def _line(self, cancelled, deadline):
+        fd = self.process.stdout.fileno()
+        while b"\n" not in self.state["buffer"]:
+            ready, _, _ = select.select([fd], [], [], POLL)
+            if ready:
+                chunk = os.read(fd, 65536)
+                if not chunk:
+                    self.process.wait()
+                    raise SupervisorFailed("the supervisor ended without a result (exit %s): %s" % (
+                        self.process.returncode, self.process.stderr.read(2000).decode(errors="replace").strip()[-300:]))
+                self.state["buffer"] += chunk
+            elif cancelled():
+                raise Cancelled()
+            elif time.monotonic() > deadline:
+                raise SupervisorFailed("no result from the supervisor %g s past the time limit" % SUPERVISOR_GRACE)
+        line, self.state["buffer"] = self.state["buffer"].split(b"\n", 1)
+        return json.loads(line)
+
+    def close(self):
+        """Closes the lifeline: the supervisor kills what runs, cleans up and exits."""
+        try:
+            self.process.stdin.close()
+        except (BrokenPipeError, ValueError):
+            pass
+        try:
+            self.process.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            self.process.send_signal(signal.SIGTERM)
+            try:
+                self.process.wait(timeout=2)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait()
+        self.process.stdout.close()
+        self.process.stderr.close()
 
 
-def _base_row(task):
-    row = {k: v for k, v in task.items() if k != "scene_text"}
-    row.update({"task_id": task["id"], "worker": _worker_name(), "host": socket.gethostname(),
+def worker_supervisors():
+    """The supervisors of this Dask worker's threads ({thread id: a SupervisorProcess's state}),
+    kept on the Worker object, which outlives its tasks; None outside a worker."""
+    try:
+        from distributed import get_worker
+        worker = get_worker()
+    except (ImportError, ValueError):
+        return None
+    pool = getattr(worker, "_birkhoff_cart_supervisors", None)
+    if pool is None:
+        pool = worker._birkhoff_cart_supervisors = {}
+    return pool
+
+
+class Supervised:
+    """`with Supervised(argv, files, time_limit) as process:` runs argv under the thread's
+    supervisor and gives the Process; leaving the block lets the supervisor remove the task
+    directory. Raises Cancelled when `cancelled()` turns true first (the supervisor then stops the
+    process). `pool`: the worker's supervisors, one per thread, reused task after task; without
+    one, a supervisor of its own is started and closed around the task."""
+
+    def __init__(self, argv, files, time_limit, cancelled=dask_task_cancelled, pool=None):
+        self.spec = {"op": "run", "argv": argv, "files": files, "time_limit": time_limit}
+        self.cancelled = cancelled
+        self.deadline = time.monotonic() + time_limit + SUPERVISOR_GRACE
+        self.pool = pool
+        self.supervisor = None
+
+    def _supervisor(self):
+        if self.pool is None:
+            return SupervisorProcess()
+        thread = threading.get_ident()
+        living = {t.ident for t in threading.enumerate()}
+        for ident in [i for i in self.pool if i not in living]:  # a thread gone: its supervisor too
+            SupervisorProcess(self.pool.pop(ident)).close()
+        state = self.pool.get(thread)
+        supervisor = SupervisorProcess(state) if state is not None else None
+        if supervisor is None or not supervisor.alive():
+            supervisor = SupervisorProcess()
+            self.pool[thread] = supervisor.state
+        return supervisor
+
+    def __enter__(self):
+        self.supervisor = self._supervisor()
+        try:
+            self.supervisor.run(self.spec)
+            started = self.supervisor.answer(self.cancelled, self.deadline)
+            if "error" in started:
+                raise SupervisorFailed(started["error"])
+            return Process(self.supervisor.answer(self.cancelled, self.deadline), started["directory"])
+        except Cancelled:
+            self._finish("stop")
+            raise
+        except SupervisorFailed:
+            self._discard()
+            raise
+
+    def _finish(self, op):
+        try:
+            self.supervisor.send({"op": op, "id": self.supervisor.task})
+        except SupervisorFailed:
+            self._discard()
+            return
+        if self.pool is None:
+            self.supervisor.close()
+
+    def _discard(self):
+        if self.pool is not None and self.pool.get(threading.get_ident()) is self.supervisor.state:
+            del self.pool[threading.get_ident()]
+        self.supervisor.close()
+
+    def __exit__(self, *exception):
+        self._finish("done")
+        return False
+
+
+def base_row(wire):
+    """The task's fields and where it runs."""
+    skip = ("argv", "files", "needs_reference", "study_kind", "id", "scene_text")
+    row = {k: v for k, v in wire.items() if k not in skip}
+    row.update({"task_id": wire["id"], "worker": _worker_name(), "host": socket.gethostname(),
                 "load_average_1min": os.getloadavg()[0]})
     return row
 
 
-def _finish(row, status, stdout, stderr, cpu, wall, timed_out):
-    row["exit_status"] = status
-    row["process_cpu_s"] = cpu
-    row["process_wall_s"] = wall
-    if timed_out:
-        row["outcome"] = "timeout"
-        row["reason"] = "killed after the time limit of %g s" % row["time_limit"]
-    if row.get("outcome") not in ("ok",) and stderr:
-        row["stderr_tail"] = stderr[-STDERR_TAIL:]
-    return row
-
-
-def run_task(task, bin_dir, reference_text=None):
-    """Runs one task (see study_file) and returns its row. Never raises for a failed process: a
-    crash, a refusal or a timeout is a row with outcome "failed" or "timeout"."""
-    row = _base_row(task)
-    work_dir = tempfile.mkdtemp(prefix="birkhoff_cart_task_")
+def run_task(wire, outcome, reference=None, cancelled=dask_task_cancelled):
+    """Runs one task (its `wire`: tasks.Task.wire plus argv, files, needs_reference) and returns its
+    row. `outcome(wire, process)` is the study kind's judgement of the process (a dict for the row);
+    `reference` the row of the reference a measurement needs. Never raises for a failed process: a
+    crash, a refusal or a timeout is a row with outcome "failed" or "timeout"; raises Cancelled
+    when the task is cancelled while it runs."""
+    row = base_row(wire)
+    files = dict(wire["files"])
+    if wire.get("needs_reference"):
+        text = (reference or {}).get("reference_text") if (reference or {}).get("outcome") == "ok" else None
+        if text is None:
+            row.update(outcome="failed", reason="its reference did not finish")
+            return row
+        files["reference.csv"] = text
     try:
-        scene = os.path.join(work_dir, task["scene"])
-        with open(scene, "w") as f:
-            f.write(task["scene_text"])
-        if task["type"] == "simulate":
-            return _simulate(task, row, bin_dir, scene, work_dir)
-        command = [os.path.join(bin_dir, "work_precision"), "--scene", scene, "--duration", repr(task["duration"]),
-                   "--checkpoints", ",".join(repr(t) for t in task["checkpoints"]), "--label", task["label"]]
-        if task["type"] in ("reference", "reference_check"):
-            output = os.path.join(work_dir, "reference.csv")
-            command += ["--reference-run", "--reference-kind", task["reference_kind"], "--output", output]
-            if task["type"] == "reference_check":
-                command += ["--check-setting"]
-        else:
-            command += ["--measure", "--method", task["method"], "--repetitions", str(task["repetitions"])]
-            if "step" in task:
-                command += ["--step", repr(task["step"])]
-            else:
-                command += ["--tolerance", repr(task["tolerance"])]
-            if "simulator_step" in task:
-                command += ["--simulator-step", repr(task["simulator_step"])]
-            if task.get("analytic"):
-                command += ["--analytic-reference"]
-            else:
-                if reference_text is None:
-                    row.update(outcome="failed", reason="its reference did not finish")
-                    return row
-                reference = os.path.join(work_dir, "reference.csv")
-                with open(reference, "w") as f:
-                    f.write(reference_text)
-                command += ["--reference-file", reference]
-        status, stdout, stderr, cpu, wall, timed_out = run_process(command, task["time_limit"], work_dir)
-        result = None
-        if not timed_out:
-            try:
-                result = json.loads(stdout.strip().splitlines()[-1]) if stdout.strip() else None
-            except ValueError:
-                result = None
-        if result is not None:
-            row["result"] = result
-        if task["type"] in ("reference", "reference_check") and status == 0 and result is not None:
-            with open(output) as f:
-                row["reference_text"] = f.read()
-        if timed_out:
-            pass
-        elif status == 0 and result is not None:
-            row["outcome"] = "ok"
-        elif status == 4 and result is not None:
-            # The process worked and measured that the method cannot step this run (a step
-            # failed: too large a step, a singularity): a result of the study, not a failure.
-            row["outcome"] = "step_failed"
-            row["reason"] = result.get("status")
-        else:
-            row["outcome"] = "failed"
-            row["reason"] = (result or {}).get("status") or "exit status %d" % status
-        return _finish(row, status, stdout, stderr, cpu, wall, timed_out)
-    finally:
-        shutil.rmtree(work_dir, ignore_errors=True)
-
-
-def _simulate(task, row, bin_dir, scene, work_dir):
-    """cart_simulate on the task's scene and settings: the row holds the exit status, the last CSV
-    row (t, x, y, θ, energy) and, for a refusal, its one-line reason."""
-    csv = os.path.join(work_dir, "out.csv")
-    command = [os.path.join(bin_dir, "cart_simulate"), "--scene", scene, "--integrator", task["method"],
-               "--output", csv, "--quiet"]
-    # A study's `tolerances` are dopri5's local tolerance [-], or with step_control: reversible the
-    # position error [m] the control aims at (cart_simulate's --position-tolerance).
-    tolerance_option = "--position-tolerance" if task.get("step_control") == "reversible" else "--tolerance"
-    for key, option in (("step", "--step"), ("tolerance", tolerance_option), ("duration", "--duration"),
-                        ("output_rate", "--output-rate"), ("birkhoffian_form", "--birkhoffian-form"),
-                        ("random_scene", "--random-scene")):
-        if key in task:
-            command += [option, str(task[key])]
-    if task.get("step_control", "fixed") != "fixed":
-        command += ["--step-control", task["step_control"]]
-    status, stdout, stderr, cpu, wall, timed_out = run_process(command, task["time_limit"], work_dir)
-    last = None
-    if os.path.exists(csv):
-        with open(csv) as f:
-            lines = [line for line in f.read().splitlines() if line.strip()]
-        if len(lines) > 1:
-            header, values = lines[0].split(","), lines[-1].split(",")
-            try:
-                last = {name: float(value) if value else None for name, value in zip(header, values)}
-            except ValueError:
-                last = None
-            row["rows"] = len(lines) - 1
-    if last:
-        row["result"] = {k: last.get(k) for k in ("t", "x", "y", "theta", "chi", "energy", "p2")}
-        rhs = re.search(r"(\d+) rhs evaluations", stdout)
-        if rhs:
-            row["result"]["rhs_evaluations"] = int(rhs.group(1))
-    if not timed_out:
-        outcome, reason = judge(status, stderr, csv, task.get("start_time"), task.get("duration"), task.get("step", 0.0))
-        if outcome == "refused" and task.get("expect") != "finish_or_refuse":
-            outcome = "failed"
-        row["outcome"] = outcome
-        if reason:
-            row["reason"] = reason
-    return _finish(row, status, stdout, stderr, cpu, wall, timed_out)
+        with Supervised(wire["argv"], files, wire["time_limit"], cancelled, worker_supervisors()) as process:
+            row.update(outcome(wire, process))
+    except SupervisorFailed as error:
+        row.update(outcome="failed", reason=str(error))
+        return row
+    row["exit_status"] = process.status
+    row["process_cpu_s"] = process.cpu_s
+    row["process_wall_s"] = process.wall_s
+    if process.timed_out:
+        row["outcome"] = "timeout"
+        row["reason"] = "killed after the time limit of %g s" % wire["time_limit"]
+    if row.get("outcome") != "ok" and process.stderr:
+        row["stderr_tail"] = process.stderr[-STDERR_TAIL:]
+    return row

@@ -16,7 +16,8 @@ using Spelling = std::pair<Enum, const char*>;
 const Spelling<BirkhoffianForm> kFormSpellings[] = {{BirkhoffianForm::kAutonomous, "autonomous"},
                                                     {BirkhoffianForm::kPaper, "paper"}};
 const Spelling<StepControl> kControlSpellings[] = {{StepControl::kFixed, "fixed"},
-                                                   {StepControl::kReversible, "reversible"}};
+                                                   {StepControl::kReversible, "reversible"},
+                                                   {StepControl::kAdaptive, "adaptive"}};
 
 template <class Enum, std::size_t N>
 const char* text_of(Enum value, const Spelling<Enum> (&spellings)[N]) {

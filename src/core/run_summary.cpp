@@ -15,18 +15,26 @@ std::string local_error_estimate_summary(const StepStatistics& statistics, const
 }
 
 std::string step_control_summary(const IntegratorSettings& settings, const StepStatistics& statistics) {
-  if (settings.step_control != StepControl::kReversible) return "";
+  if (settings.step_control == StepControl::kFixed) return "";
+  const char* control = to_string(settings.step_control);
   char text[320];
   if (statistics.internal_steps == 0) {
-    std::snprintf(text, sizeof text, "reversible step control: position tolerance %.3g m (no internal step yet)",
+    std::snprintf(text, sizeof text, "%s step control: position tolerance %.3g m (no internal step yet)", control,
                   settings.position_tolerance);
-  } else {
+  } else if (settings.step_control == StepControl::kReversible) {
     std::snprintf(text, sizeof text,
                   "reversible step control: position tolerance %.3g m, eps = %.4g rad (pilot order %.2g), %llu internal steps "
                   "from %.3g s to %.3g s",
                   settings.position_tolerance, statistics.control_fictive_step, statistics.control_observed_order,
                   static_cast<unsigned long long>(statistics.internal_steps), statistics.internal_step_min,
                   statistics.internal_step_max);
+  } else {
+    std::snprintf(text, sizeof text,
+                  "adaptive step control: position tolerance %.3g m, %llu internal steps from %.3g s to %.3g s, "
+                  "%llu rejected",
+                  settings.position_tolerance, static_cast<unsigned long long>(statistics.internal_steps),
+                  statistics.internal_step_min, statistics.internal_step_max,
+                  static_cast<unsigned long long>(statistics.rejected_steps));
   }
   return text;
 }
@@ -65,7 +73,7 @@ std::string run_summary(const Simulation& simulation, const AccuracyGuard& guard
   std::snprintf(line, sizeof line,
                 "summary: scene '%s', integrator %s, %s = %g s, t = %.9g s, %llu steps, %llu rhs evaluations\n",
                 simulation.scene().name.c_str(), simulation.integrator_name().c_str(),
-                simulation.scene().integrator.step_control == StepControl::kReversible ? "output step" : "h", simulation.step_size(),
+                simulation.scene().integrator.step_control != StepControl::kFixed ? "output step" : "h", simulation.step_size(),
                 simulation.state().time, static_cast<unsigned long long>(statistics.steps),
                 static_cast<unsigned long long>(statistics.rhs_evaluations));
   text += line;

@@ -128,22 +128,27 @@ IntegratorSettings read_integrator(const SceneReader& reader, const YAML::Node& 
   settings.tolerance_horizon =
       reader.optional_number(node, key, "tolerance_horizon", Range::kPositive, settings.tolerance_horizon);
   // One meaning per key: `tolerance` is dopri5's local tolerance [-] (kept in the shipped scenes for a
-  // switch to dopri5), `position_tolerance` the position error [m] the reversible step control aims at.
-  if (settings.step_control == StepControl::kReversible) {
-    if (!integrator_entry(settings.name).reversible()) {
-      reader.fail(key + ".step_control", "'reversible' is for the symmetric Birkhoffian members (" +
-                                             name_list(reversible_integrator_names()) + "), not '" + settings.name +
-                                             "'");
+  // switch to dopri5), `position_tolerance` the position error [m] a step control aims at.
+  if (settings.step_control != StepControl::kFixed) {
+    const std::string control = to_string(settings.step_control);
+    const bool offered = settings.step_control == StepControl::kReversible ? integrator_entry(settings.name).reversible()
+                                                                           : integrator_entry(settings.name).adaptive();
+    if (!offered) {
+      const bool reversible = settings.step_control == StepControl::kReversible;
+      reader.fail(key + ".step_control",
+                  "'" + control + "' is for " + (reversible ? "the symmetric Birkhoffian members (" : "(") +
+                      name_list(reversible ? reversible_integrator_names() : adaptive_integrator_names()) + "), not '" +
+                      settings.name + "'");
     }
     if (!reader.has(node, "position_tolerance")) {
-      reader.fail(key + ".position_tolerance", "is required with 'step_control: reversible': the position error [m] "
-                                               "allowed at the horizon (" + key + ".tolerance is dopri5's local "
-                                               "tolerance [-], not this)");
+      reader.fail(key + ".position_tolerance", "is required with 'step_control: " + control +
+                                               "': the position error [m] allowed at the horizon (" + key +
+                                               ".tolerance is dopri5's local tolerance [-], not this)");
     }
   } else {
-    for (const char* reversible_only : {"position_tolerance", "tolerance_horizon"}) {
-      if (reader.has(node, reversible_only)) {
-        reader.fail(key + "." + reversible_only, "is only for 'step_control: reversible'");
+    for (const char* controlled_only : {"position_tolerance", "tolerance_horizon"}) {
+      if (reader.has(node, controlled_only)) {
+        reader.fail(key + "." + controlled_only, "is only for 'step_control: reversible' or 'adaptive'");
       }
     }
   }
@@ -205,9 +210,10 @@ Scene read_scene(const SceneReader& reader, const YAML::Node& root, const std::s
   scene.accuracy = scene_detail::read_accuracy(reader, root["accuracy"]);
   scene.odometry_sensor = scene_detail::read_odometry_sensor(reader, root["odometry_sensor"]);
   scene.actuators = scene_detail::read_actuators(reader, root);
-  if (scene.actuators.any() && scene.integrator.step_control == StepControl::kReversible) {
-    reader.fail("integrator.step_control", "reversible cannot go with steering_actuator, drive_actuator or "
-                                           "steering_end_stops (docs/actuators.md §4); use fixed");
+  if (scene.actuators.any() && scene.integrator.step_control != StepControl::kFixed) {
+    reader.fail("integrator.step_control", std::string(to_string(scene.integrator.step_control)) +
+                                               " cannot go with steering_actuator, drive_actuator or "
+                                               "steering_end_stops (docs/actuators.md §4); use fixed");
   }
   if (scene.actuators.end_stops) {
     if (scene.paper_special_case) {

@@ -10,45 +10,12 @@
 
 #include "birkhoff_cart/core/birkhoffian_system.h"
 #include "birkhoff_cart/core/cart_birkhoffian.h"
+#include "integrators/cart_joint_rates.h"
 
 namespace birkhoff_cart {
 namespace {
 
 namespace odeint = boost::numeric::odeint;
-
-/// The joint state (z, y) of the autonomous Birkhoffian form, as odeint sees it.
-using Joint = std::array<double, kBirkhoffianSize + kPassiveSize>;
-
-/// (ż, ẏ) for odeint: ż = K₀⁻¹(∇H̃ + Λ) = (ω, ṗ) with ṗ = ∂T*/∂q|_ω + Λ_nh + Q (CartModel::momentum_rate,
-/// eq. (3.6)) and ẏ = g(z, y, t) (CartBirkhoffianBase::passive_rates), from ONE evaluation of
-/// ω = M(χ)⁻¹ p and of the loads Q. birkhoffian_rates() and passive_coordinate_rates() would each
-/// evaluate both again (the loads were a third of the shadow's cost); the rates are the same up to
-/// round-off.
-struct JointRates {
-  const CartAutonomousBirkhoffian* system;
-  const CartModel* model;
-  void operator()(const Joint& state, Joint& rate, double time) const {
-    StateVector<CartAutonomousBirkhoffian, double> z;
-    for (int i = 0; i < kBirkhoffianSize; ++i) z(i) = state[i];
-    const double chi = z(kSteeringAngleIndex);
-    const Vector2<double> omega = system->quasi_velocity(z);                 // ω = M(χ)⁻¹ p
-    const Vector2<double> force = system->generalized_force(chi, omega, time);  // Q
-    const Vector2<double> momentum_rate = model->momentum_rate(chi, omega, force);
-    rate[kArcLengthIndex] = omega(0);
-    rate[kSteeringAngleIndex] = omega(1);
-    rate[kForwardMomentumIndex] = momentum_rate(0);
-    rate[kSteeringMomentumIndex] = momentum_rate(1);
-    const CoordinateRates<double> rates =
-        model->coordinate_rates(state[kBirkhoffianSize + kHeadingIndex], chi, omega);
-    double* passive = rate.data() + kBirkhoffianSize;
-    passive[kXIndex] = rates.x_rate;
-    passive[kYIndex] = rates.y_rate;
-    passive[kHeadingIndex] = rates.heading_rate;
-    for (int wheel = 0; wheel < 4; ++wheel) passive[kWheel1Index + wheel] = rates.wheel_spin_rate[wheel];
-    passive[kAppliedWorkIndex] = omega.dot(force);
-    passive[kSteeringImpulseIndex] = force(1);
-  }
-};
 
 /// One continuing dopri5 run with dense output (see shadow_reference.h).
 class DenseShadowReference : public ReferenceSolution {
@@ -108,11 +75,7 @@ class DenseShadowReference : public ReferenceSolution {
 
  private:
   void restart(const CartState& state, double step_size_guess) {
-    const CartBirkhoffianPoint point = system_.to_birkhoffian(state);
-    Joint x;
-    for (int i = 0; i < kBirkhoffianSize; ++i) x[i] = point.z(i);
-    for (int i = 0; i < kPassiveSize; ++i) x[kBirkhoffianSize + i] = point.y(i);
-    stepper_.initialize(x, state.time, step_size_guess);
+    stepper_.initialize(joint_of(system_.to_birkhoffian(state)), state.time, step_size_guess);
   }
 
   /// The shadow state at `time` [s]: the current step's end, or the dense-output interpolant inside
@@ -124,11 +87,7 @@ class DenseShadowReference : public ReferenceSolution {
     } else {
       stepper_.calc_state(time, x);
     }
-    StateVector<CartAutonomousBirkhoffian, double> z;
-    PassiveVector<CartAutonomousBirkhoffian, double> y;
-    for (int i = 0; i < kBirkhoffianSize; ++i) z(i) = x[i];
-    for (int i = 0; i < kPassiveSize; ++i) y(i) = x[kBirkhoffianSize + i];
-    return system_.to_cart_state(z, y, time);
+    return cart_state_of(system_, x, time);
   }
 
   IntegratorSettings settings_;

@@ -40,10 +40,10 @@ void require_finite_torque(double torque, const char* which) {
 /// step being committed, while the actuators' state and the end-stop events advance step by step
 /// (docs/actuators.md §4).
 IntegratorSettings integrator_settings(const Scene& scene) {
-  if (scene.actuators.any() && scene.integrator.step_control == StepControl::kReversible) {
-    throw std::invalid_argument(
-        "integrator.step_control: reversible cannot go with steering_actuator, drive_actuator or steering_end_stops "
-        "(docs/actuators.md); use fixed");
+  if (scene.actuators.any() && scene.integrator.step_control != StepControl::kFixed) {
+    throw std::invalid_argument(std::string("integrator.step_control: ") + to_string(scene.integrator.step_control) +
+                                " cannot go with steering_actuator, drive_actuator or steering_end_stops "
+                                "(docs/actuators.md); use fixed");
   }
   IntegratorSettings settings = scene.integrator;
   if (settings.tolerance_horizon == 0.0) settings.tolerance_horizon = scene.duration;
@@ -61,6 +61,7 @@ Simulation::Simulation(const Scene& scene)
       schedule_(plan_steps(scene.initial_state.time, scene.duration, scene.integrator.step_size)),
       loaded_initial_state_(scene.initial_state) {
   stepper_->prepare(state_, statistics_);  // the reversible control's pilots; refuses an unreachable tolerance
+  stepper_->land_on(schedule_.end_time);    // a step control lands on the run's end
   initial_energy_ = model_.energy(state_);
   initial_steering_momentum_ = model_.steering_momentum(state_);
   reference_ = make_reference_solution(scene_, model_, effects_);
@@ -86,6 +87,7 @@ void Simulation::plan_run(double duration) {
   const StepSchedule schedule = plan_steps(state_.time, duration, scene_.integrator.step_size);
   schedule_ = schedule;
   endless_ = false;
+  stepper_->land_on(schedule_.end_time);
 }
 
 double Simulation::next_step_time() const {
@@ -94,6 +96,10 @@ double Simulation::next_step_time() const {
 }
 
 void Simulation::step() {
+  if (controlled_off_grid_) {
+    throw std::logic_error("scene '" + scene_.name + "': advance_output_to() took this run off the step grid; " +
+                           "continue with advance_output_to() or reset()");
+  }
   if (finished_off_grid_) {
     throw std::logic_error("scene '" + scene_.name + "' already ended off the step grid at t = " +
                            std::to_string(state_.time) + " s; reset() before stepping again");
@@ -113,6 +119,10 @@ void Simulation::step_on_schedule() {
 }
 
 void Simulation::step_to(double time) {
+  if (controlled_off_grid_) {
+    throw std::logic_error("scene '" + scene_.name + "': advance_output_to() took this run off the step grid; " +
+                           "continue with advance_output_to() or reset()");
+  }
   const double remaining = time - state_.time;  // [s]
   const double longest = scene_.integrator.step_size * (1.0 + 2.0 * kMinFinalStepFraction);  // [s]
   if (!std::isfinite(time) || !(remaining > 0.0) || remaining > longest) {
@@ -141,6 +151,33 @@ void Simulation::take_step(double h, double next_time) {
   state_ = next;
   statistics_ = statistics;
   ++steps_taken_;
+}
+
+bool Simulation::takes_own_steps() const {
+  return scene_.integrator.step_control != StepControl::kFixed || integrator_entry(scene_.integrator.name).takes_tolerance();
+}
+
+void Simulation::advance_output_to(double time) {
+  if (!takes_own_steps()) {
+    throw std::logic_error("scene '" + scene_.name + "': advance_output_to() is for a member with its own steps (a "
+                           "step control, or dopri5); " + scene_.integrator.name + " steps at fixed steps of h");
+  }
+  const double end = end_time();
+  if (!std::isfinite(time) || !(time > state_.time) || time > end) {
+    std::ostringstream message;
+    message.precision(17);
+    message << "advance_output_to(" << time << " s) from t = " << state_.time << " s needs t < time <= the end "
+            << end << " s";
+    throw std::invalid_argument(message.str());
+  }
+  take_step(time - state_.time, time);
+  controlled_off_grid_ = true;
+  if (!endless_ && time == end) steps_taken_ = schedule_.total_steps();  // at_end()
+}
+
+void Simulation::observe_grid(CartStepper::GridObserver observer) {
+  grid_observer_ = std::move(observer);
+  stepper_->observe_grid(grid_observer_);
 }
 
 void Simulation::advance_to(double time) {
@@ -207,6 +244,7 @@ void Simulation::start_run(Scene run_scene) {
   StepStatistics statistics;
   CartState state = start;
   stepper->prepare(state, statistics);  // the reversible control's pilots may refuse the state
+  stepper->land_on(schedule.end_time);
   // Commit: nothing below throws.
   scene_ = std::move(run_scene);
   schedule_ = schedule;
@@ -218,9 +256,13 @@ void Simulation::start_run(Scene run_scene) {
   steps_taken_ = 0;
   end_stop_events_ = 0;
   finished_off_grid_ = false;
+  controlled_off_grid_ = false;
+  stepper_->observe_grid(grid_observer_);
   initial_energy_ = model_.energy(state_);
   initial_steering_momentum_ = model_.steering_momentum(state_);
 }
+
+void Simulation::land_on(double time) { stepper_->land_on(time); }
 
 bool Simulation::accepts_steering_command() const { return static_cast<bool>(effects_.steering_command()); }
 bool Simulation::accepts_drive_command() const { return static_cast<bool>(effects_.drive_command()); }
@@ -252,13 +294,18 @@ double Simulation::steering_command() const {
 double Simulation::drive_command() const { return effects_.drive_command() ? effects_.drive_command()->value : 0.0; }
 
 Diagnostics Simulation::diagnostics() const {
-  Diagnostics diagnostics;
-  diagnostics.energy = model_.energy(state_);
-  // T* − T*₀ − ∫ω·Q dt (docs eq. (3.7)) and p2 − p2₀ − ∫Q2 dt (docs eq. (3.8))
-  diagnostics.energy_balance_residual = diagnostics.energy - initial_energy_ - state_.applied_work;
-  diagnostics.p2_balance_residual = model_.steering_momentum(state_) - initial_steering_momentum_ - state_.steering_impulse;
-  diagnostics.max_constraint_residual = model_.max_constraint_residual(state_);
+  Diagnostics diagnostics = balances_of(state_);
   if (reference_) reference_->compare(state_, diagnostics);
+  return diagnostics;
+}
+
+Diagnostics Simulation::balances_of(const CartState& state) const {
+  Diagnostics diagnostics;
+  diagnostics.energy = model_.energy(state);
+  // T* − T*₀ − ∫ω·Q dt (docs eq. (3.7)) and p2 − p2₀ − ∫Q2 dt (docs eq. (3.8))
+  diagnostics.energy_balance_residual = diagnostics.energy - initial_energy_ - state.applied_work;
+  diagnostics.p2_balance_residual = model_.steering_momentum(state) - initial_steering_momentum_ - state.steering_impulse;
+  diagnostics.max_constraint_residual = model_.max_constraint_residual(state);
   return diagnostics;
 }
 

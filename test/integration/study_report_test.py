@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """rostest study_report: the benchmark report's race of the best Birkhoffian member against each
-peer (src/birkhoff_cart_study/race.py, report.py), on synthetic rows whose answers are known.
+peer (src/birkhoff_cart_study/race.py, kinds/work_precision_report.py), on synthetic rows whose answers are known.
 
 The work–precision curves are power laws (straight lines in log–log), so interpolation between
 measured points is exact and the two curves cross at a known error. Checked: the lower envelope
@@ -24,7 +24,9 @@ sys.path.insert(0, os.path.join(rospkg.RosPack().get_path(PACKAGE), "src"))
 
 from birkhoff_cart_study import race as race_module  # noqa: E402
 from birkhoff_cart_study.race import cost_at, crossovers, describe_crossover, envelope, race  # noqa: E402
-from birkhoff_cart_study.report import GOALS, accuracy_tables, measurements, write_report  # noqa: E402
+from birkhoff_cart_study.kinds.work_precision import RUN_SETTINGS  # noqa: E402
+from birkhoff_cart_study.kinds.work_precision_report import GOALS, accuracy_tables, measurements  # noqa: E402
+from birkhoff_cart_study.report import write_report  # noqa: E402
 
 RELATIVE = 1e-12  # tolerance of the exact (power-law) interpolations, relative
 
@@ -61,6 +63,7 @@ BIRKHOFFIAN = [run("birkhoff_a", 10.0 ** -k, birkhoffian_cost(10.0 ** -k), "h=%d
 def measure_row(label, method, cpu, error, energy_j, energy_rel, step=None, tolerance=None):
     """A measurement row as the study runner writes it (docs/studies.md, 'The rows')."""
     row = {"type": "measure", "outcome": "ok", "label": label, "method": method, "task_id": "%s-%s-%s" % (method, step, tolerance),
+           "analytic": True,  # judged against a closed form: every goal resolved
            "result": {"cpu_median_s": cpu, "wall_median_s": cpu, "position_error_m": error,
                       "max_energy_residual_J": energy_j, "max_energy_residual_rel": energy_rel,
                       "max_p2_residual": 0.0, "rhs_evaluations": 1000, "duration_s": 100.0,
@@ -190,13 +193,15 @@ class StudyReportTest(unittest.TestCase):
                 for r in PEER]
         rows += [measure_row("whirl", "birkhoff_gauss8", r["cpu"], r["error"], 1e-9, 1e-11, step=0.01 * (1 + i))
                  for i, r in enumerate(BIRKHOFFIAN)]
-        runs = measurements(rows)
-        table, ratios, summary, _ = accuracy_tables(runs)
+        runs = measurements(rows, RUN_SETTINGS)
+        table, ratios, summary, _ = accuracy_tables(runs, {})
         self.assertIn("| energy ≤ 1e-11 J |", table.splitlines()[0])
         self.assertEqual(table.splitlines()[0].count("|"), len(GOALS) + 2)
         self.assertIn("Birkhoffian cheaper below 1e-10 m", ratios)
-        page = write_report({"name": "synthetic"}, rows, os.path.join(self.directory, "results.md"),
-                            "study synthetic.yaml", "synthetic rows")
+        page = os.path.join(self.directory, "results.md")
+        unresolved = write_report({"name": "synthetic", "kind": "work_precision"}, rows, page, "study synthetic.yaml",
+                                  "synthetic rows")
+        self.assertEqual(unresolved, [])
         with open(page) as f:
             text = f.read()
         self.assertIn(ratios, text)

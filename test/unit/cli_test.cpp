@@ -175,7 +175,8 @@ TEST(CartSimulate, ToleranceWithAFixedStepMemberIsRefused) {
                                           "at --step H"),
               std::string::npos)
         << outcome.standard_error;
-    EXPECT_NE(outcome.standard_error.find("--step-control reversible --position-tolerance M"), std::string::npos)
+    EXPECT_NE(outcome.standard_error.find("--step-control adaptive or reversible --position-tolerance M"),
+              std::string::npos)
         << outcome.standard_error;
   }
   const CliOutcome dopri5 = run_cli("--scene '" + scene_path("free_coast") +

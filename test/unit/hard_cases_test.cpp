@@ -415,11 +415,17 @@ Scene step_torque_scene() {
   return scene;
 }
 
-/// The measured outcome of the large-step runs, pinned: only birkhoff4 in the paper form at
-/// h = 0.2 s stops (Newton meets a singular Jacobian at t ≈ 2.27 s: its inner substep γ₂h = −0.34 s
-/// runs backwards through the step torque); every other member, new ones included, runs to the end.
+/// The measured outcome of the large-step runs, pinned: two compositions at h = 0.2 s stop with a
+/// named error, where a backward sub-step (γh = −0.34 s for birkhoff4, −0.14 s for birkhoff6_kahan_li)
+/// runs through the step torque and its stage solve settles on a spurious root: birkhoff4 in the
+/// paper form at t = 2 s (the step's energy balance breaks; before that check it ran on to a
+/// singular Newton matrix at 2.27 s with T* = 3e78 J), birkhoff6_kahan_li in the autonomous form at
+/// 5.8 s (its stages wander 1e5 rad from their starting values; before that check it handed out
+/// T* = 5e16 J). Every other member, new ones included, runs to the end.
 bool large_step_run_stops(const Method& method, double h) {
-  return method.integrator == "birkhoff4" && method.form == BirkhoffianForm::kPaper && h == 0.2;
+  if (h != 0.2) return false;
+  return (method.integrator == "birkhoff4" && method.form == BirkhoffianForm::kPaper) ||
+         (method.integrator == "birkhoff6_kahan_li" && method.form == BirkhoffianForm::kAutonomous);
 }
 
 TEST(LargeSteps, BoundedOrAClearErrorNeverGarbage) {

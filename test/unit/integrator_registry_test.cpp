@@ -35,7 +35,7 @@ namespace {
 constexpr double kOrderSlack = 0.3;            // |observed − claimed order| up to order 4 [-]
 constexpr double kHighOrderExcess = 2.0;       // orders ≥ 5 may show up to this much more (see expect_order) [-]
 constexpr double kReferenceTolerance = 1e-13;  // dopri5's tolerance for the forced cart's reference [-]
-constexpr double kFullStepTolerance = 1e6;     // dopri5 accepts every full step: its map is the DP5 map [-]
+constexpr double kMemberTolerance = 1e-8;        // an adaptive member's own tolerance (dopri5) [-]
 constexpr double kForcedCartDuration = 1.0;    // [s]
 constexpr double kPositionTolerance = 1e-5;    // the reversible runs' position tolerance [m]
 constexpr double kWhirlDuration = 2.0;         // the reversible runs' duration [s]
@@ -62,7 +62,7 @@ CartState run_steps(const Scene& scene, const IntegratorSettings& settings, int 
 IntegratorSettings fixed_settings(const IntegratorEntry& member) {
   IntegratorSettings settings;
   settings.name = member.name;
-  if (member.takes_tolerance()) settings.tolerance = kFullStepTolerance;
+  if (member.takes_tolerance()) settings.tolerance = kMemberTolerance;
   return settings;
 }
 
@@ -121,6 +121,12 @@ TEST_P(RegistryRow, TheBuiltStepperHasTheRowsNameOrderAndSymmetry) {
 TEST_P(RegistryRow, TheMeasuredOrderIsTheRowsOrder) {
   // sine_steer_torque (χ₀ = 0, ω1 = 5 m/s, τ = 3 cos(π t) N·m) over 1 s against dopri5 at 1e-13.
   const IntegratorEntry& member = GetParam();
+  if (member.takes_tolerance()) {
+    // dopri5 runs its own steps over the whole run (dopri5_cart_stepper.h): the caller's step does
+    // not set its error, and its order is measured on its stepper (integrator_contract_test).
+    std::printf("[ measured ] %s: its own steps, order checked by integrator_contract_test\n", member.name);
+    return;
+  }
   const Scene scene = load("sine_steer_torque");
   IntegratorSettings reference_settings;
   reference_settings.name = "dopri5";
@@ -289,9 +295,9 @@ TEST(BirkhoffianForms, EveryTextParsesAndRoundTrips) {
 }
 
 TEST(StepControls, EveryTextParsesAndRoundTrips) {
-  EXPECT_EQ(step_control_names(), (std::vector<std::string>{"fixed", "reversible"}));
+  EXPECT_EQ(step_control_names(), (std::vector<std::string>{"fixed", "reversible", "adaptive"}));
   for (const std::string& text : step_control_names()) EXPECT_EQ(to_string(parse_step_control(text)), text);
-  for (StepControl control : {StepControl::kFixed, StepControl::kReversible}) {
+  for (StepControl control : {StepControl::kFixed, StepControl::kReversible, StepControl::kAdaptive}) {
     EXPECT_EQ(parse_step_control(to_string(control)), control);
   }
 }
@@ -318,8 +324,9 @@ TEST(BirkhoffianForms, AnUnknownFormIsRefusedByNameWithTheKnownOnesAndTheClosest
 
 TEST(StepControls, AnUnknownControlIsRefusedByNameWithTheKnownOnesAndTheClosest) {
   EXPECT_EQ(refusal(parse_step_control, "reversable"),
-            "unknown step_control 'reversable' (known: fixed, reversible; did you mean 'reversible'?)");
-  EXPECT_EQ(refusal(parse_step_control, "adaptive"), "unknown step_control 'adaptive' (known: fixed, reversible)");
+            "unknown step_control 'reversable' (known: fixed, reversible, adaptive; did you mean 'reversible'?)");
+  EXPECT_EQ(refusal(parse_step_control, "variable"),
+            "unknown step_control 'variable' (known: fixed, reversible, adaptive)");
   EXPECT_NE(refusal(parse_step_control, "FIXED"), "");
   EXPECT_NE(refusal(parse_step_control, ""), "");
 }

@@ -151,6 +151,23 @@ class CartBirkhoffianBase {
            sqrt(forward * forward + acceleration(1) * acceleration(1) + S(floor4));
   }
 
+  /// The step density of the reversible step control's time transformation
+  /// (time_transformed_system.h, docs/birkhoffian.md §11.2, eq. (B.44)) [1/s]:
+  ///   σ = √(ω2² + θ̇² + σ₀²),   θ̇ = ω1 sin χ / l (eq. (2.3)),   σ₀ = 1 s⁻¹,
+  /// how fast the front axle turns against the body and the body against the ground: on the
+  /// jackknife whirl χ turns at up to 5 rad/s near the jackknife and 0.8 rad/s elsewhere, so the
+  /// steps shrink there. σ₀ bounds the steps where the cart neither turns nor steers. A function of
+  /// z alone, even in p (the reversal p ↦ −p leaves it unchanged).
+  template <class S>
+  S step_density(const Vector<S>& z) const {
+    using std::sin;
+    using std::sqrt;
+    constexpr double kDensityFloor = 1.0;  // σ₀ [1/s]
+    const Vector2<S> omega = quasi_velocity(z);
+    const S heading_rate = omega(0) * sin(z(kSteeringAngleIndex)) / model_->parameters().wheelbase;
+    return sqrt(omega(1) * omega(1) + heading_rate * heading_rate + S(kDensityFloor * kDensityFloor));
+  }
+
   /// H̃ = ½ pᵀ M(χ)⁻¹ p = T* [J].
   template <class S>
   S hamiltonian(const Vector<S>& z) const {
@@ -260,6 +277,10 @@ class CartAutonomousBirkhoffian : public CartBirkhoffianBase, public CartStageRa
  public:
   using CartBirkhoffianBase::CartBirkhoffianBase;
   using CartBirkhoffianBase::Vector;
+
+  /// w = z: the chart's rates are ż, so a step's F(w⁺) serves as the rate of its end point (dense
+  /// output, system_traits.h).
+  static constexpr bool kDarbouxChartIsIdentity = true;
 
   /// No structure epoch: K = K₀ does not depend on time.
   void begin_step(double /*t*/) {}

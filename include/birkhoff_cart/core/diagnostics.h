@@ -18,6 +18,7 @@ struct StepStatistics {
   std::uint64_t internal_steps = 0;                                          ///< grid steps taken
   double internal_step_min = std::numeric_limits<double>::infinity();        ///< smallest |h| [s]
   double internal_step_max = 0.0;                                            ///< largest |h| [s]
+  std::uint64_t rejected_steps = 0;  ///< attempts an error-per-step control rejected (adaptive_step_control.h)
   double control_fictive_step = std::numeric_limits<double>::quiet_NaN();    ///< the reversible control's ε [rad]
   double control_observed_order = std::numeric_limits<double>::quiet_NaN();  ///< order its pilots showed [-]
 

@@ -17,6 +17,7 @@ enum class BirkhoffianForm {
 enum class StepControl {
   kFixed,       ///< "fixed": steps of step_size
   kReversible,  ///< "reversible": the reversible controller's steps (docs/birkhoffian.md §11)
+  kAdaptive,    ///< "adaptive": error-per-step control on the member's estimate (docs/birkhoffian.md §12)
 };
 
 /// The text of a form or a control in scene files, on the command line and in messages.

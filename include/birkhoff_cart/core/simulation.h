@@ -86,6 +86,26 @@ class Simulation {
   /// limits of step_schedule.h.
   void restart_from(const CartState& initial_state);
 
+  /// For a member with its own steps (integrator.step_control adaptive or reversible; dopri5, one
+  /// run over the whole run): the state at `time` [s],
+  /// any instant after the current one up to end_time(), however far (the control's own steps, and
+  /// its dense output between them; the run's end and land_on() instants exactly). The output grid
+  /// of such a run need not be a multiple of step_size(). After it, step() and step_on_schedule()
+  /// refuse (the run left their grid); at_end() is true once `time` is end_time(). Throws
+  /// std::logic_error for a member at fixed steps, std::invalid_argument for a time not ahead or past
+  /// the end, StepError as step().
+  void advance_output_to(double time);
+  /// Does this run's member take its own steps (a step control; dopri5)?
+  bool takes_own_steps() const;
+  /// `observer` is called with the state after every accepted step of a step control's own grid
+  /// (not for fixed-step members). Kept across reset() and restart_from(); an empty function stops it.
+  void observe_grid(CartStepper::GridObserver observer);
+
+  /// An instant [s] a step control's own steps must end on exactly instead of interpolating there
+  /// (CartStepper::land_on; the run's end always is one). For the current run only: reset() and
+  /// restart_from() forget it. Fixed-step members ignore it.
+  void land_on(double time);
+
   /// Command inputs (zero-order hold). Throw std::invalid_argument for a non-finite torque and
   /// std::logic_error when the scene's effect does not take commands.
   bool accepts_steering_command() const;
@@ -111,6 +131,9 @@ class Simulation {
 
   /// Invariants and errors of the current state (reference error only when the scene asks).
   Diagnostics diagnostics() const;
+  /// The energy and p2 balances and the constraint residual of `state`, a state of this run (a grid
+  /// state seen by observe_grid): diagnostics() without the reference comparison.
+  Diagnostics balances_of(const CartState& state) const;
   const StepStatistics& statistics() const { return statistics_; }
 
  private:
@@ -133,6 +156,8 @@ class Simulation {
 
   std::uint64_t steps_taken_ = 0;
   bool finished_off_grid_ = false;  ///< step_to() left the grid t₀ + n h
+  bool controlled_off_grid_ = false;  ///< advance_output_to() left the grid t₀ + n h
+  CartStepper::GridObserver grid_observer_;
   bool endless_ = false;            ///< plan_run(+inf): no end, schedule_ unused
   StepStatistics statistics_;
   double initial_energy_ = 0.0;

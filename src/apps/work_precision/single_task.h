@@ -8,8 +8,9 @@
 //   work_precision --reference-run --scene FILE --duration T --reference-kind extended_precision|dopri5
 //                  [--checkpoints t1,t2,...] [--check-setting] --output REF.csv
 //     the reference states at the checkpoints (extended precision: long double rkf78 at 1e-18;
-//     dopri5: 1e-13), or with --check-setting those of the setting it is checked against (1e-17;
-//     1e-12), written with 17 digits; prints one JSON object naming the run.
+//     dopri5: 1e-13), or with --check-setting those of the run it is checked against (long double
+//     bulirsch_stoer at 1e-18; dopri5 at 1e-12: reference.h), written with 17 digits; prints one
+//     JSON object naming the run.
 // Checkpoints are times from the start [s]; the last one must be the duration (added when missing).
 #pragma once
 
@@ -207,12 +208,7 @@ inline std::vector<CartState> read_reference_file(const std::string& path, const
 /// compares their files).
 inline int run_reference_task(const SingleTask& task) {
   BenchScene bench = single_task_scene(task);
-  ReferenceRun run;
-  if (task.reference_kind == "extended_precision") {
-    run = extended_precision_run(bench, "rkf78", task.check_setting ? kExtendedCheckTolerance : kExtendedReferenceTolerance);
-  } else {
-    run = dopri5_run(bench, task.check_setting ? kDopri5ReferenceCheckTolerance : kDopri5ReferenceTolerance);
-  }
+  const ReferenceRun run = reference_run(bench, task.reference_kind, task.check_setting);
   write_reference_file(task.output, bench, run);
   std::printf("{\"reference\":%s,\"setting\":%s,\"rhs_evaluations\":%llu,\"wall_s\":%s}\n",
               json_string(run.name).c_str(), task.check_setting ? "\"check\"" : "\"reference\"",

@@ -29,6 +29,14 @@ std::unique_ptr<CartStepper> make_cart_stepper(const IntegratorSettings& setting
     }
     return member->make_reversible(settings, model, effects);
   }
+  if (settings.step_control == StepControl::kAdaptive) {
+    const IntegratorEntry* member = find_integrator(settings.name);
+    if (member == nullptr || !member->adaptive()) {
+      throw std::invalid_argument("step_control 'adaptive' is for (" +
+                                  name_list(adaptive_integrator_names()) + "), not '" + settings.name + "'");
+    }
+    return member->make_adaptive(settings, model, effects);
+  }
   return integrator_entry(settings.name).make_fixed(settings, model, effects);
 }
 

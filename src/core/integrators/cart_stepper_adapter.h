@@ -62,6 +62,7 @@ class CartStepperAdapter final : public FixedStepCartStepper<Stepper> {
     require_finite_result(name_, time, step_size, point.z, point.y);
     const CartState next = system_.to_cart_state(point.z, point.y, time + step_size);
     require_finite_speeds(name_, time, step_size, next, point.z);
+    require_energy_balance(name_, system_.model(), state, next, step_size);
     ++counted.steps;
     state = next;
     statistics = counted;
@@ -111,6 +112,7 @@ class CarriedCartStepperAdapter final : public FixedStepCartStepper<Stepper> {
     carried_.reduce_angles();
     const CartState next = carried_.output(system_, time + step_size);
     require_finite_speeds(name_, time, step_size, next, point.z);
+    require_energy_balance(name_, system_.model(), state, next, step_size);
     carried_.valid = true;
     ++counted.steps;
     state = next;

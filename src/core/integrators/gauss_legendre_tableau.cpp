@@ -104,7 +104,13 @@ GaussLegendreTableau compute_tableau(int s) {
       for (int k = column; k <= s; ++k) system[row][k] -= factor * system[column][k];
     }
   }
-  for (int i = 0; i < s; ++i) tableau.increment_weights[i] = static_cast<double>(system[i][s] / system[i][i]);
+  Real increment_weight_sum = 0.0L;
+  for (int i = 0; i < s; ++i) {
+    const Real weight = system[i][s] / system[i][i];
+    tableau.increment_weights[i] = static_cast<double>(weight);
+    increment_weight_sum += weight;
+  }
+  tableau.remainder_weight = static_cast<double>(std::round(1.0L - increment_weight_sum));  // (−1)^s exactly
 
   // Embedded weights on {0, c₁ … c_s, 1} (eq. (B.36)): endpoint weights ±β, β = 1/((s+1)(s+2)), with
   // the sign (−1)^{s+1} that makes the rule exact to degree s; interior ones from exactness to s − 1.

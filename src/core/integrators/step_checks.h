@@ -4,11 +4,13 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 
+#include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/integrators/cart_stepper.h"
 #include "birkhoff_cart/core/state.h"
 
@@ -72,6 +74,33 @@ inline void require_finite_speeds(const std::string& integrator, double time, do
   if (!std::isfinite(kinetic_energy)) {
     throw_non_finite(integrator, time, step_size, "kinetic energy T* (the step blew up)", kinetic_energy);
   }
+}
+
+/// Does a step from `start` to `next` keep its kinetic energy within what it had and what the loads
+/// supplied (eq. (3.7))? A step that gains more than 9× (T*₀ + |ΔW|) beyond the work ΔW is no
+/// discretization error but a step that settled on a spurious root of its implicit equations far
+/// from the motion (birkhoff6_kahan_li at h = 0.2 s on hard_cases_test's step torques: T* grew
+/// 1e13-fold in one step and stayed finite). Coarse on purpose: a low-order method's honest energy
+/// error where the cart comes to rest is far below it.
+inline bool energy_balance_holds(const CartModel& model, const CartState& start, const CartState& next) {
+  const double energy_start = model.energy(start);  // T*₀ [J]
+  const double work = next.applied_work - start.applied_work;  // ΔW [J]
+  const double gained = model.energy(next) - energy_start - work;  // [J]
+  constexpr double kEnergyFloor = 1e-6;  // [J]: a cart at rest
+  return !(gained > 9.0 * (energy_start + std::abs(work)) + kEnergyFloor);
+}
+
+/// Throws StepError naming the broken energy balance of a step (energy_balance_holds).
+inline void require_energy_balance(const std::string& integrator, const CartModel& model, const CartState& start,
+                                   const CartState& next, double step_size) {
+  if (energy_balance_holds(model, start, next)) return;
+  std::ostringstream message;
+  message.precision(17);
+  message << integrator << " step from t = " << start.time << " s (h = " << step_size
+          << " s) broke the energy balance: T* went from " << model.energy(start) << " J to " << model.energy(next)
+          << " J with " << next.applied_work - start.applied_work
+          << " J of applied work (an implicit solve that settled on a spurious root)";
+  throw StepError(message.str());
 }
 
 }  // namespace stepper_checks

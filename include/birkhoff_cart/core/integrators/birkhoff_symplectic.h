@@ -87,6 +87,8 @@ class BirkhoffComposition {
   static constexpr int kOrder = Weights::kOrder;
   static constexpr bool kSymmetric = true;
   static constexpr IntegratorKind kKind = IntegratorKind::kComposition;
+  /// ê ∝ h⁴: the sub-steps' O((γᵢh)³) terms cancel (Σγᵢ³ = 0); the error-per-step control's exponent.
+  static constexpr int kErrorEstimateOrder = 4;
   static const char* name() { return Weights::name(); }
   template <class System>
   using Memory = CollocationMemory<System, 1>;

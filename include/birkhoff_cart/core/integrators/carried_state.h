@@ -30,10 +30,17 @@ struct CarriesStateTrait<Stepper, System,
 template <class Stepper, class System>
 constexpr bool kCarriesState = CarriesStateTrait<Stepper, System>::value;
 
-template <class System, class Memory>
+/// The memory of a carried state that only hands states out (an adapter's last output).
+struct NoStepMemory {
+  void clear() {}
+};
+
+/// `PointSystem`: the system whose point is carried — System itself, or a system built on it with
+/// the same leading coordinates (the time-transformed system: y with t appended).
+template <class System, class Memory, class PointSystem = System>
 struct CarriedCartState {
   bool valid = false;
-  CompensatedPoint<System> point;
+  CompensatedPoint<PointSystem> point;
   Memory memory;
   double steering_turns = 0.0;  ///< whole turns removed from χ [-]
   double heading_turns = 0.0;   ///< whole turns removed from θ [-]

@@ -2,6 +2,7 @@
 // the registry (integrator_registry.h) by name.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -39,6 +40,14 @@ class CartStepper {
   /// cannot work from this start (a tolerance out of the member's reach), so that a caller refuses
   /// the scene at load instead of failing its first step.
   virtual void prepare(const CartState& /*start*/, StepStatistics& /*statistics*/) {}
+  /// An instant [s] the member's own steps must end on exactly (the run's end, a caller's
+  /// checkpoint): a member with its own step grid (the adaptive and reversible step controls) lands
+  /// there instead of interpolating; the others step at the caller's h and ignore it.
+  virtual void land_on(double /*time*/) {}
+  /// Called with the state after every accepted step of the member's own grid (a step control's
+  /// internal steps; nothing for the fixed-step members, whose steps are the caller's own).
+  using GridObserver = std::function<void(const CartState& grid_state)>;
+  virtual void observe_grid(GridObserver /*observer*/) {}
 };
 
 /// Makes the registry's member settings.name (integrator_registry.h) for `model` and `effects`

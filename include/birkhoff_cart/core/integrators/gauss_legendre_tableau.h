@@ -24,6 +24,9 @@ struct GaussLegendreTableau {
   /// dᵢ = (bᵀA⁻¹)ᵢ: w⁺ = w + Σ dᵢ Zᵢ with the stage increments Zᵢ = Wᵢ − w = h Σⱼ aᵢⱼ Fⱼ, which needs no
   /// evaluation of F at the converged stages (eq. (B.33); Hairer–Wanner II §IV.8) [-].
   std::array<double, kMaxGaussStages> increment_weights{};
+  /// 1 − Σᵢ dᵢ = (−1)^s: the weight of the carried remainder r in w⁺ = w + (1 − Σdᵢ) r + Σ dᵢZᵢ when the
+  /// increments Zᵢ = r + h Σⱼ aᵢⱼFⱼ include it (eq. (B.34)) [-].
+  double remainder_weight = 1.0;
   /// The embedded solution's weights b̂ on the s + 2 nodes {0, c₁ … c_s, 1} (eq. (B.36)):
   /// ŵ = w + h (b̂₀ F(w, tₖ) + Σᵢ b̂ᵢ Fᵢ + b̂_{s+1} F(w⁺, tₖ₊₁)), exact for polynomials of degree ≤ s
   /// (order s + 1; for s = 1 Simpson's rule, exact to degree 3). The endpoint weights are

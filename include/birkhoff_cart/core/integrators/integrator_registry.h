@@ -34,12 +34,15 @@ struct IntegratorEntry {
   const char* description = "";  ///< one line for help texts
   CartStepperFactory make_fixed = nullptr;       ///< step_control fixed: steps of h
   CartStepperFactory make_reversible = nullptr;  ///< step_control reversible (docs/birkhoffian.md §11); null: not offered
+  CartStepperFactory make_adaptive = nullptr;    ///< step_control adaptive (docs/birkhoffian.md §12); null: not offered
   /// Evaluates the s stages' right-hand sides of an iteration together, with one vector sin/cos on
   /// CPUs with AVX2 (vector_math.h; docs/integrators.md, "Stage evaluation").
   bool vector_stages = false;
 
   /// Takes step_control reversible (the symmetric Birkhoffian members).
   bool reversible() const { return make_reversible != nullptr; }
+  /// Takes step_control adaptive (the Birkhoffian members: their local error estimate drives it).
+  bool adaptive() const { return make_adaptive != nullptr; }
   /// Reads `tolerance` (a local error tolerance [-]) instead of stepping at h alone.
   bool takes_tolerance() const { return kind == IntegratorKind::kAdaptive; }
 };
@@ -59,5 +62,8 @@ std::vector<std::string> integrator_names();
 
 /// The names of the members that take step_control reversible, in the registry's order.
 std::vector<std::string> reversible_integrator_names();
+
+/// The names of the members that take step_control adaptive, in the registry's order.
+std::vector<std::string> adaptive_integrator_names();
 
 }  // namespace birkhoff_cart

@@ -1,0 +1,104 @@
+// The dense output of a step control's grid for the cart (docs/birkhoffian.md §12.3): the grid
+// points in (z, y) with the angles χ and θ kept on one branch — the whole turns the grid took out of
+// a point are put back relative to the newest point — and their Hermite interpolant
+// (hermite_dense_output.h). Private to the core library.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+
+#include "birkhoff_cart/core/birkhoffian_system.h"
+#include "birkhoff_cart/core/diagnostics.h"
+#include "birkhoff_cart/core/integrators/hermite_dense_output.h"
+#include "birkhoff_cart/core/integrators/system_traits.h"
+#include "birkhoff_cart/core/state.h"
+
+namespace birkhoff_cart {
+
+/// The last `Points` grid points of a run and their Hermite interpolant in (z, y): of degree
+/// 2·Points − 1, its position error estimated against the one through Points − 1.
+template <class System, int Points>
+class GridDenseOutput {
+ public:
+  static constexpr int kSize = System::kDimension + System::kPassiveDimension;
+  using Joint = Eigen::Matrix<double, kSize, 1>;
+
+  /// Forget the points (a restart of the grid).
+  void clear() { history_.clear(); }
+  int size() const { return history_.size(); }
+
+  /// Adds the grid point of `grid` (a CarriedCartState) at time t [s]; with an identity chart, the
+  /// rates its step's local error estimate evaluated there come along (first same as last: no
+  /// evaluation later).
+  template <class Carried>
+  void push(const Carried& grid, double t) {
+    push_point(grid.point, grid.steering_turns, grid.heading_turns, t);
+    if constexpr (system_traits::kDarbouxChartIsIdentity<System>) {
+      const auto& memory = grid.memory;
+      if (memory.end_rate_valid && memory.end_time == t) set_newest_rate(memory.end_rate, memory.end_passive_rate);
+    }
+  }
+
+  /// Adds a grid point (a CompensatedPoint whose z and leading y are the system's; t [s]) with the
+  /// turns taken out of its angles.
+  template <class Point>
+  void push_point(const Point& point, double steering_turns, double heading_turns, double t) {
+    // Keep the held points on the newest point's branch: shift them by the turns it took out.
+    if (history_.size() > 0) {
+      history_.shift_component(kSteeringAngleIndex, kTwoPi * (steering_turns_ - steering_turns));
+      history_.shift_component(System::kDimension + kHeadingIndex, kTwoPi * (heading_turns_ - heading_turns));
+    }
+    steering_turns_ = steering_turns;
+    heading_turns_ = heading_turns;
+    Joint x;
+    x << point.z + point.z_remainder, (point.y + point.y_remainder).template head<System::kPassiveDimension>();
+    history_.push(t, x);
+  }
+
+  /// The newest point's rates ż, ẏ [per second], when known without an evaluation.
+  template <class ZRate, class YRate>
+  void set_newest_rate(const ZRate& z_rate, const YRate& y_rate) {
+    Joint rate;
+    rate << z_rate, y_rate.template head<System::kPassiveDimension>();
+    history_.set_rate(0, rate);
+  }
+
+  /// The carried point at t [s] (inside the newest step) in `out`, with the newest point's turns.
+  /// The rates of the points that lack them are evaluated here, once each. Returns an estimate of
+  /// the interpolant's position error [m] (against the interpolant one point shorter: a conservative
+  /// one; NaN with a single point).
+  template <class Carried>
+  double at(System& system, double t, Carried& out, StepStatistics& statistics) {
+    for (int j = 0; j < history_.size(); ++j) {
+      if (history_.has_rate(j)) continue;
+      const Joint& x = history_.value(j);
+      const StateVector<System, double> z = x.template head<System::kDimension>();
+      const PassiveVector<System, double> y = x.template tail<System::kPassiveDimension>();
+      const double time = history_.time(j);
+      Joint rate;
+      rate << birkhoffian_rates(system, z, time), passive_coordinate_rates(system, z, y, time);
+      ++statistics.rhs_evaluations;
+      ++statistics.passive_evaluations;
+      history_.set_rate(j, rate);
+    }
+    Joint difference;
+    const Joint x = history_.at(t, &difference);
+    out.point.z = x.template head<System::kDimension>();
+    out.point.y = x.template tail<System::kPassiveDimension>();
+    out.point.z_remainder.setZero();
+    out.point.y_remainder.setZero();
+    out.steering_turns = steering_turns_;
+    out.heading_turns = heading_turns_;
+    return std::hypot(difference(System::kDimension + kXIndex), difference(System::kDimension + kYIndex));
+  }
+
+ private:
+  static constexpr double kTwoPi = 6.283185307179586476925286766559;
+
+  HermiteDenseOutput<kSize, Points> history_{Points};
+  double steering_turns_ = 0.0;  ///< of the newest point [-]
+  double heading_turns_ = 0.0;   ///< of the newest point [-]
+};
+
+}  // namespace birkhoff_cart
