@@ -49,6 +49,10 @@ std::uint64_t GuardedRun::advance(std::uint64_t count, const std::vector<StepCom
     throw std::invalid_argument("per-step commands: " + std::to_string(commands.size()) + " given for " +
                                 std::to_string(count) + " steps");
   }
+  if (off_grid_ && count > 0) {
+    throw std::logic_error("run_to() gave states between " + simulation_.integrator_name() +
+                           "'s own steps (its dense output): continue with run_to() or run(), or reset()");
+  }
   std::uint64_t taken = 0;
   try {
     for (; taken < count && !simulation_.at_end(); ++taken) {
@@ -67,32 +71,84 @@ std::uint64_t GuardedRun::advance(std::uint64_t count, const std::vector<StepCom
 }
 
 void GuardedRun::run_to_end() {
+  if (off_grid_) {
+    if (!simulation_.at_end()) states_at({simulation_.end_time()});
+    return;
+  }
   while (!simulation_.at_end()) step_once();
 }
 
+namespace {
+
+std::string time_text(double time) {
+  std::ostringstream text;
+  text.precision(17);
+  text << "time " << time << " s";
+  return text.str();
+}
+
+/// Finite and increasing, or std::invalid_argument naming the time.
+void require_increasing(const std::vector<double>& times) {
+  for (std::size_t j = 0; j < times.size(); ++j) {
+    if (!std::isfinite(times[j])) throw std::invalid_argument(time_text(times[j]) + " is not finite");
+    if (j > 0 && !(times[j] > times[j - 1])) {
+      throw std::invalid_argument("the times must increase: " + time_text(times[j]) + " follows " +
+                                  time_text(times[j - 1]));
+    }
+  }
+}
+
+}  // namespace
+
 std::vector<CartState> GuardedRun::states_at(const std::vector<double>& times,
                                              const std::function<void(const Simulation&)>& observe) {
+  require_increasing(times);
+  return simulation_.takes_own_steps() ? dense_states_at(times, observe) : grid_states_at(times, observe);
+}
+
+std::vector<CartState> GuardedRun::dense_states_at(const std::vector<double>& times,
+                                                   const std::function<void(const Simulation&)>& observe) {
+  const double now = simulation_.state().time;  // [s]
+  const double end = simulation_.end_time();     // [s]
+  for (double time : times) {
+    if (time < now || time > end) {
+      std::ostringstream text;
+      text.precision(17);
+      text << time_text(time) << (time < now ? " is in the past: the run is at t = " : " is beyond the run's end ")
+           << (time < now ? now : end) << " s";
+      throw std::invalid_argument(text.str());
+    }
+  }
+  std::vector<CartState> states;
+  states.reserve(times.size());
+  for (double time : times) {
+    if (time > simulation_.state().time) {
+      simulation_.advance_output_to(time);  // the member's own steps, and its dense output at `time`
+      off_grid_ = true;
+      guard_.check(time, simulation_.diagnostics(), simulation_.statistics());
+    }
+    states.push_back(simulation_.state());
+    if (observe) observe(simulation_);
+  }
+  return states;
+}
+
+std::vector<CartState> GuardedRun::grid_states_at(const std::vector<double>& times,
+                                                  const std::function<void(const Simulation&)>& observe) {
   const StepSchedule& schedule = simulation_.schedule();
   const double h = schedule.step_size;  // [s]
-  const auto describe = [&](double time) {
-    std::ostringstream text;
-    text.precision(17);
-    text << "time " << time << " s";
-    return text.str();
-  };
   const auto grid = [&]() {
     std::ostringstream text;
     text.precision(17);
     text << "the step schedule's instants t0 + n*h (t0 = " << schedule.start_time << " s, h = " << h
-         << " s) and its end " << schedule.end_time << " s; states between steps are not interpolated";
+         << " s) and its end " << schedule.end_time << " s: " << simulation_.integrator_name()
+         << " steps at fixed steps, and its states between them are not interpolated (a step control gives any "
+            "instant)";
     return text.str();
   };
   // The step count at each time, checked before any step is taken.
   std::vector<std::uint64_t> targets;
-  for (std::size_t j = 0; j < times.size(); ++j) {
-    const double time = times[j];
-    if (!std::isfinite(time)) throw std::invalid_argument(describe(time) + " is not finite");
-    if (j > 0 && !(time > times[j - 1])) throw std::invalid_argument("the times must increase: " + describe(time) + " follows " + describe(times[j - 1]));
+  for (double time : times) {
     std::uint64_t n = 0;
     if (std::abs(time - schedule.end_time) <= kTimeResolution * h) {
       n = schedule.total_steps();
@@ -100,14 +156,14 @@ std::vector<CartState> GuardedRun::states_at(const std::vector<double>& times,
       const double steps = std::round((time - schedule.start_time) / h);
       if (!(steps >= 0.0) || steps > static_cast<double>(schedule.whole_steps) ||
           std::abs(schedule.grid_time(static_cast<std::uint64_t>(steps)) - time) > kTimeResolution * h) {
-        throw std::invalid_argument(describe(time) + " is not one of " + grid());
+        throw std::invalid_argument(time_text(time) + " is not one of " + grid());
       }
       n = static_cast<std::uint64_t>(steps);
     }
     if (n < simulation_.steps_taken()) {
       std::ostringstream text;
       text.precision(17);
-      text << describe(time) << " is in the past: the run is at t = " << simulation_.state().time << " s";
+      text << time_text(time) << " is in the past: the run is at t = " << simulation_.state().time << " s";
       throw std::invalid_argument(text.str());
     }
     targets.push_back(n);
@@ -124,6 +180,7 @@ std::vector<CartState> GuardedRun::states_at(const std::vector<double>& times,
 
 void GuardedRun::reset() {
   simulation_.reset();
+  off_grid_ = false;
   guard_.reset();
   guard_.check(simulation_.schedule().start_time, simulation_.diagnostics(), simulation_.statistics());
 }

@@ -1,7 +1,7 @@
 // What the Python module (birkhoff_cart.simulator) drives: a Simulation with the accuracy guard that
 // cart_simulate keeps beside it, checked at the same instants (the start, every output instant
-// t₀ + k/output_rate on the step grid, the end), so that a run's verdict does not depend on how the
-// caller cuts it into calls. Plain C++ (no Python types): the bindings in simulator_module.cpp only
+// t₀ + k/output_rate on the step grid, the end; and every instant of a time grid the caller asks
+// for), so that a run's verdict does not depend on how the caller cuts it into calls. Plain C++ (no Python types): the bindings in simulator_module.cpp only
 // convert. docs/python.md.
 #pragma once
 
@@ -45,16 +45,23 @@ class GuardedRun {
   std::uint64_t advance(std::uint64_t count, const std::vector<StepCommands>& commands, bool record,
                         std::vector<CartState>* states);
 
-  /// Steps to the run's end.
+  /// Steps to the run's end (after states_at() left the step grid: the member's dense output to
+  /// the end).
   void run_to_end();
 
   /// The state at each of `times` [s] (increasing, from now to the run's end), advancing the run to
-  /// the last one; `observe` sees the simulation at each. The one place the module turns times into
-  /// states: today each time must be an instant of the step schedule (t₀ + n·h, or the end);
-  /// std::invalid_argument names a time that is not, one in the past, and one beyond the end, before
+  /// the last one; `observe` sees the simulation at each, after the guard checked it. The one place
+  /// the module turns times into states. A member with its own steps (a step control; dopri5) gives
+  /// any instant, from its dense output (Simulation::advance_output_to); the run then continues only
+  /// through states_at() and run_to_end() (advance() refuses). A member at fixed steps gives the
+  /// instants of the step schedule (t₀ + n·h, and the end). std::invalid_argument names a time that
+  /// is not finite, not increasing, in the past, beyond the end or (fixed steps) off the grid, before
   /// any step is taken.
   std::vector<CartState> states_at(const std::vector<double>& times,
                                    const std::function<void(const Simulation&)>& observe = {});
+
+  /// Did states_at() take the run off the step grid (dense output of a member with its own steps)?
+  bool off_grid() const { return off_grid_; }
 
   /// Back to the scene's start: the simulation's reset() and a fresh guard.
   void reset();
@@ -67,6 +74,11 @@ class GuardedRun {
   AccuracyGuard guard_;
   std::uint64_t steps_between_checks_ = 1;
   bool checks_at_output_instants_ = false;  ///< the output interval is a whole number of steps
+  bool off_grid_ = false;                   ///< states_at() used the member's dense output
+  std::vector<CartState> dense_states_at(const std::vector<double>& times,
+                                         const std::function<void(const Simulation&)>& observe);
+  std::vector<CartState> grid_states_at(const std::vector<double>& times,
+                                        const std::function<void(const Simulation&)>& observe);
 };
 
 }  // namespace python

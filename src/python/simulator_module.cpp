@@ -164,6 +164,7 @@ py::list integrator_list() {
     row["symmetric"] = member.symmetric;
     row["kind"] = to_string(member.kind);
     row["reversible"] = member.reversible();
+    row["adaptive"] = member.adaptive();
     row["takes_tolerance"] = member.takes_tolerance();
     row["vector_stages"] = member.vector_stages;
     row["description"] = member.description;
@@ -219,8 +220,8 @@ PYBIND11_MODULE(simulator, m) {
   m.attr("DIAGNOSTIC_FIELDS") = names_tuple(kDiagnosticFields);
 
   m.def("integrators", &integrator_list,
-        "The integrator registry: one dict per member (name, order, symmetric, kind, reversible, takes_tolerance, "
-        "vector_stages, description), in its order.");
+        "The integrator registry: one dict per member (name, order, symmetric, kind, reversible, adaptive, "
+        "takes_tolerance, vector_stages, description), in its order.");
   m.def("load_scene", &scene_from, py::arg("source"), py::arg("overrides") = py::none(),
         "A validated Scene from a scene file's path or a dict shaped like one, with `overrides` (a dict) merged "
         "into it first: maps key by key, None removes a key. Raises SceneError naming the key.");
@@ -320,8 +321,9 @@ PYBIND11_MODULE(simulator, m) {
             return py::make_tuple(state_array, matrix_array(diagnostic_rows, kDiagnosticFields.size()));
           },
           py::arg("times"), py::arg("diagnostics") = false,
-          "The states at `times` [s] (increasing, from now to the end; instants of the step schedule), advancing "
-          "the run to the last; with diagnostics=True also the diagnostics there: (states, diagnostics).")
+          "The states at `times` [s] (increasing, from now to the end), advancing the run to the last; with "
+          "diagnostics=True also the diagnostics there: (states, diagnostics). A member with its own steps (a step "
+          "control, dopri5) gives any instant from its dense output; a member at fixed steps the step schedule's.")
       .def("reset", &GuardedRun::reset, "Back to the scene's start (state, counters, commands' initial values, guard).")
       .def_property_readonly("time", [](const GuardedRun& run) { return run.simulation().state().time; }, "t [s]")
       .def_property_readonly("steps_taken", [](const GuardedRun& run) { return run.simulation().steps_taken(); })

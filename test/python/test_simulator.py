@@ -115,9 +115,10 @@ def test_the_registry_is_the_cli_s():
     for member in members:
         assert f"  {member['name']} " in help_text
     assert "birkhoff_gauss4" in names and "dopri5" in names and len(names) == len(set(names)) >= 12
+    birkhoffian = {member["name"] for member in members if member["kind"] in ("Birkhoffian collocation", "composition")}
     assert {member["name"] for member in members if member["reversible"]} == {
-        member["name"] for member in members if member["symmetric"] and member["kind"] in (
-            "Birkhoffian collocation", "composition")}
+        name for name in birkhoffian if next(m for m in members if m["name"] == name)["symmetric"]}
+    assert {member["name"] for member in members if member["adaptive"]} >= birkhoffian
 
 
 @pytest.mark.parametrize("member", [member["name"] for member in simulator.integrators()])
@@ -127,16 +128,17 @@ def test_every_member_runs_at_fixed_steps_and_under_each_control_it_takes(member
     final = simulation.run()
     assert simulation.at_end and final[FIELD["t"]] == 0.2 and np.all(np.isfinite(final))
     assert simulation.integrator == member
-    if row["reversible"]:
-        reversible = simulator.Simulation(short("jackknife_whirl", 1.0, name=member, step_size=0.5,
-                                                step_control="reversible", position_tolerance=1e-5))
-        assert np.all(np.isfinite(reversible.run()))
-        assert reversible.statistics()["internal_steps"] > 2
-    else:
-        with pytest.raises(simulator.SceneError) as raised:
-            short("jackknife_whirl", 1.0, name=member, step_size=0.5, step_control="reversible",
-                  position_tolerance=1e-5)
-        assert raised.value.key.startswith("integrator.")
+    for control, takes_it in (("reversible", row["reversible"]), ("adaptive", row["adaptive"])):
+        if takes_it:
+            controlled = simulator.Simulation(short("jackknife_whirl", 1.0, name=member, step_size=0.5,
+                                                    step_control=control, position_tolerance=1e-5))
+            assert np.all(np.isfinite(controlled.run())), control
+            assert controlled.statistics()["internal_steps"] > 2, control
+        else:
+            with pytest.raises(simulator.SceneError) as raised:
+                short("jackknife_whirl", 1.0, name=member, step_size=0.5, step_control=control,
+                      position_tolerance=1e-5)
+            assert raised.value.key.startswith("integrator."), control
 
 
 # --- stepping -------------------------------------------------------------------------------------
@@ -226,6 +228,28 @@ def test_run_to_returns_the_states_of_the_step_grid_with_their_diagnostics():
         assert np.array_equal(diagnostics[j], stepped.diagnostics(), equal_nan=True)
     assert states.shape == (11, len(simulator.STATE_FIELDS))
     assert diagnostics.shape == (11, len(simulator.DIAGNOSTIC_FIELDS))
+
+
+@pytest.mark.parametrize("integrator", [{"name": "dopri5", "step_size": 0.01, "tolerance": 1e-12},
+                                        {"name": "birkhoff_gauss6", "step_size": 0.1, "step_control": "adaptive",
+                                         "position_tolerance": 1e-10}])
+def test_a_member_with_its_own_steps_gives_any_instant_from_its_dense_output(integrator):
+    # Instants off the output grid (h = 0.01 s, 0.1 s), against a fine fixed-step run that has them on
+    # its grid (birkhoff_gauss8 at 0.1 ms); then the run goes on only through run_to() and run().
+    scene = short("sine_steer_torque", 1.0, **integrator)
+    times = [0.0015, 0.3337, 0.5]
+    dense = simulator.Simulation(scene)
+    states = dense.run_to(times)
+    assert list(states[:, FIELD["t"]]) == times
+    fine = simulator.Simulation(short("sine_steer_torque", 1.0, name="birkhoff_gauss8", step_size=1e-4))
+    difference = np.abs(states - fine.run_to(times))[:, FIELD["x"]:FIELD["omega2"] + 1].max()
+    print(f"{integrator['name']}: dense output against gauss8 at 0.1 ms: {difference:.3e}")
+    assert difference < 1e-8
+    with pytest.raises(RuntimeError, match="continue with run_to"):
+        dense.step(1)
+    assert dense.run()[FIELD["t"]] == 1.0 and dense.at_end
+    dense.reset()
+    assert dense.step(10)[FIELD["t"]] == pytest.approx(10 * scene.step_size)  # on its step grid again
 
 
 def test_run_to_refuses_a_time_off_the_grid_in_the_past_or_beyond_the_end_before_stepping():
