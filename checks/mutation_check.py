@@ -168,6 +168,14 @@ MUTATIONS = [
         'append_value_field(out, "chunk_count", static_cast<std::uint32_t>(chunks_.size() - 1));',
         [("bag_file_writer_test", "*")],
     ),
+    Mutation(
+        "bag_claim_ignores_lock",
+        "a recorder takes another running recorder's locked <path>.active for a killed run's file",
+        "src/ros/bag_file_claim.cpp",
+        "if (::flock(found.get(), LOCK_EX | LOCK_NB) != 0) {",
+        "if (false) {",
+        [("bag_file_claim_test", "*")],
+    ),
 ]
 
 
