@@ -22,6 +22,8 @@ void RunRecord::open() {
     ROS_WARN("cart_sim: %s is being recorded by another running node (its .active file is locked): this run "
              "records to %s instead",
              bag_->taken_path().c_str(), bag_->path().c_str());
+    // This node's later runs go beside its own first bag (<stem>_pid<pid>_run<k>.bag).
+    if (run_index_ == 1) bag_path_ = bag_->path();
   }
   if (!bag_->crash_record_kept_as().empty()) {
     ROS_WARN("cart_sim: %s.active is the unfinished bag of a run that was killed: kept it as %s (`rosbag reindex "

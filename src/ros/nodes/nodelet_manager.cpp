@@ -2,9 +2,10 @@
 // services, as `rosrun nodelet nodelet manager`) that unloads its nodelets before roscpp shuts down
 // (docs/ros_interface.md, "Nodelets"). nodelet's own manager lets a SIGINT shut roscpp down first,
 // its log output with it, and destroys the nodelets after: cart_sim's summary, written as its
-// nodelet ends, was lost. Here the first SIGINT/SIGTERM (or roscpp's own shutdown, `rosnode kill`)
-// ends the wait, every nodelet is unloaded while roscpp runs (each ends as at its own unload:
-// cart_sim writes its summary and closes its bag), and only then does roscpp shut down.
+// nodelet ends, was lost. Here the first SIGINT/SIGTERM ends the wait, every nodelet is unloaded
+// while roscpp runs (each ends as at its own unload: cart_sim writes its summary and closes its
+// bag), and only then does roscpp shut down (`rosnode kill` shuts roscpp down first itself, as it
+// does in nodelet's manager).
 // nodelet's manager also destroys a loader's bond still open at its exit after its nodelets and
 // its callback queues, and the bond's "broken" callback then unloads the nodelet from that
 // destroyed state (boost::lock_error, abort: lockstep.launch aborted so when roslaunch stopped the
