@@ -221,6 +221,14 @@ MUTATIONS = [
         "if len(fields) not in (14, 15):",
         [(PYTEST + "test_study_outcomes.py", "own_columns")],
     ),
+    Mutation(
+        "bag_claim_ignores_lock",
+        "a recorder takes another running recorder's locked <path>.active for a killed run's file",
+        "src/ros/bag_file_claim.cpp",
+        "if (::flock(found.get(), LOCK_EX | LOCK_NB) != 0) {",
+        "if (false) {",
+        [("bag_file_claim_test", "*")],
+    ),
 ]
 
 

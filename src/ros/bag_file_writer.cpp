@@ -7,8 +7,14 @@
 #include <bzlib.h>
 #include <roslz4/lz4s.h>
 
+#include <fcntl.h>
+#include <sys/uio.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <array>
 #include <cerrno>
+#include <utility>
 
 // Every integer and double goes into the file as the host holds it in memory (append_u32,
 // append_value_field): right for the little-endian format only on a little-endian host. A
@@ -95,40 +101,75 @@ const char* BagFileWriter::compression_name(Compression compression) {
 
 BagFileWriter::BagFileWriter(const std::string& path, Compression compression, std::uint32_t chunk_threshold)
     : path_(path), compression_(compression), chunk_threshold_(chunk_threshold) {
-  file_ = std::fopen(path.c_str(), "wb");
-  if (file_ == nullptr) throw BagFileError("cannot create " + path + ": " + std::strerror(errno));
+  descriptor_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (descriptor_ < 0) throw BagFileError("cannot create " + path + ": " + std::strerror(errno));
+  start();
+}
+
+BagFileWriter::BagFileWriter(int descriptor, const std::string& path, Compression compression,
+                             std::uint32_t chunk_threshold)
+    : path_(path), compression_(compression), chunk_threshold_(chunk_threshold) {
+  descriptor_ = ::fcntl(descriptor, F_DUPFD_CLOEXEC, 0);
+  if (descriptor_ < 0) throw BagFileError("cannot write " + path + ": " + std::strerror(errno));
+  start();
+}
+
+void BagFileWriter::start() {
   chunk_.reserve(static_cast<std::size_t>(chunk_threshold_) + 64 * 1024);
   records_.reserve(64 * 1024);
   try {
-    write_bytes(kVersionLine, sizeof kVersionLine - 1);
-    file_header_position_ = position_;
+    file_header_position_ = sizeof kVersionLine - 1;
     records_.clear();
     append_file_header(records_);
-    write_bytes(records_);
-    if (std::fflush(file_) != 0) fail("cannot write the file header");
+    write_bytes({{kVersionLine, sizeof kVersionLine - 1}, {records_.data(), records_.size()}});
   } catch (...) {
-    std::fclose(file_);
-    file_ = nullptr;
+    ::close(descriptor_);
+    descriptor_ = -1;
     throw;
   }
 }
 
 BagFileWriter::~BagFileWriter() {
-  if (file_ != nullptr) std::fclose(file_);
+  if (descriptor_ >= 0) ::close(descriptor_);
 }
 
 void BagFileWriter::fail(const std::string& what) const {
   throw BagFileError(what + " of " + path_ + ": " + std::strerror(errno));
 }
 
-void BagFileWriter::write_bytes(const void* data, std::size_t size) {
-  if (size == 0) return;
-  errno = 0;
-  if (std::fwrite(data, 1, size, file_) != size) fail("cannot write " + std::to_string(size) + " bytes");
-  position_ += size;
+void BagFileWriter::write_bytes(std::initializer_list<std::pair<const void*, std::size_t>> pieces) {
+  std::array<iovec, 3> pending{};
+  std::size_t count = 0;
+  std::size_t total = 0;  // [bytes]
+  for (const auto& [data, size] : pieces) {
+    if (size == 0) continue;
+    pending.at(count++) = iovec{const_cast<void*>(data), size};
+    total += size;
+  }
+  std::size_t first = 0;
+  while (first < count) {
+    const ssize_t written = ::writev(descriptor_, pending.data() + first, static_cast<int>(count - first));
+    if (written < 0) {
+      if (errno == EINTR) continue;
+      fail("cannot write " + std::to_string(total) + " bytes");
+    }
+    if (written == 0) {
+      errno = EIO;
+      fail("cannot write " + std::to_string(total) + " bytes");
+    }
+    position_ += static_cast<std::uint64_t>(written);
+    for (auto left = static_cast<std::size_t>(written); left > 0 && first < count;) {  // a short write
+      iovec& piece = pending[first];
+      const std::size_t taken = std::min(left, piece.iov_len);
+      piece.iov_base = static_cast<std::uint8_t*>(piece.iov_base) + taken;
+      piece.iov_len -= taken;
+      left -= taken;
+      if (piece.iov_len == 0) ++first;
+    }
+  }
 }
 
-void BagFileWriter::write_bytes(const std::vector<std::uint8_t>& bytes) { write_bytes(bytes.data(), bytes.size()); }
+void BagFileWriter::write_bytes(const std::vector<std::uint8_t>& bytes) { write_bytes({{bytes.data(), bytes.size()}}); }
 
 void BagFileWriter::append_file_header(std::vector<std::uint8_t>& out) const {
   // Fields in rosbag's (std::map) order: chunk_count, conn_count, index_pos, op.
@@ -179,7 +220,7 @@ BagFileWriter::Connection& BagFileWriter::connection_of(const std::string& topic
 
 std::uint8_t* BagFileWriter::begin_message(const std::string& topic, const char* datatype, const char* md5sum,
                                            const char* definition, const ros::Time& time, std::uint32_t length) {
-  if (file_ == nullptr) throw BagFileError("bag " + path_ + " is closed");
+  if (descriptor_ < 0) throw BagFileError("bag " + path_ + " is closed");
   if (!chunk_open_) {
     chunk_open_ = true;
     open_chunk_.position = position_;
@@ -245,15 +286,13 @@ void BagFileWriter::write_chunk() {
     data = compressed_.data();
   }
 
-  records_.clear();
-  const std::size_t at = begin_header(records_);  // compression, op, size
-  append_field(records_, "compression", std::string(compression_name(compression_)));
-  append_value_field(records_, "op", kOpChunk);
-  append_value_field(records_, "size", uncompressed_size);
-  end_header(records_, at);
-  append_u32(records_, data_size);
-  write_bytes(records_);
-  write_bytes(data, data_size);
+  chunk_header_.clear();
+  const std::size_t at = begin_header(chunk_header_);  // compression, op, size
+  append_field(chunk_header_, "compression", std::string(compression_name(compression_)));
+  append_value_field(chunk_header_, "op", kOpChunk);
+  append_value_field(chunk_header_, "size", uncompressed_size);
+  end_header(chunk_header_, at);
+  append_u32(chunk_header_, data_size);
 
   // The index records after the chunk: one per connection with messages in it, by id; entries in
   // time order (rosbag's multiset keeps equal times in insertion order: a stable sort).
@@ -278,7 +317,11 @@ void BagFileWriter::write_chunk() {
     open_chunk_.counts.emplace_back(connection.id, count);
     index.clear();
   }
-  write_bytes(records_);
+  // The chunk record and its index records in one writev(2), nothing held back in a buffer: once
+  // it returns they are in the file (what SIGKILL or the second signal's _exit leaves), and a kill
+  // during it cuts off at most this chunk, which `rosbag reindex` then drops (it keeps a chunk only
+  // with its whole index records).
+  write_bytes({{chunk_header_.data(), chunk_header_.size()}, {data, data_size}, {records_.data(), records_.size()}});
   chunks_.push_back(open_chunk_);
   chunk_open_ = false;
   chunk_.clear();
@@ -286,10 +329,10 @@ void BagFileWriter::write_chunk() {
 }
 
 void BagFileWriter::close() {
-  if (file_ == nullptr) return;
+  if (descriptor_ < 0) return;
   if (broken_) {  // a partial chunk is on disk: no index after it (`rosbag reindex` stops there)
-    std::fclose(file_);
-    file_ = nullptr;
+    ::close(descriptor_);
+    descriptor_ = -1;
     throw BagFileError("bag " + path_ + " left unindexed: a chunk could not be written");
   }
   if (chunk_open_) write_chunk();
@@ -326,13 +369,15 @@ void BagFileWriter::close() {
   // The file header, now with the index position: the bag is complete from here on.
   records_.clear();
   append_file_header(records_);
-  errno = 0;
-  if (std::fflush(file_) != 0) fail("cannot write the index");
-  if (std::fseek(file_, static_cast<long>(file_header_position_), SEEK_SET) != 0) fail("cannot seek to the file header");
-  if (std::fwrite(records_.data(), 1, records_.size(), file_) != records_.size()) fail("cannot write the file header");
-  std::FILE* file = file_;
-  file_ = nullptr;
-  if (std::fclose(file) != 0) fail("cannot close");
+  const int descriptor = std::exchange(descriptor_, -1);  // closed below on every path
+  const ssize_t written =
+      ::pwrite(descriptor, records_.data(), records_.size(), static_cast<off_t>(file_header_position_));
+  const int write_error = errno;
+  if (::close(descriptor) != 0) fail("cannot close");
+  if (written != static_cast<ssize_t>(records_.size())) {
+    errno = written < 0 ? write_error : EIO;
+    fail("cannot write the file header");
+  }
 }
 
 }  // namespace birkhoff_cart

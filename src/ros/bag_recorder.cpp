@@ -8,11 +8,16 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <ctime>
 #include <stdexcept>
 
-
 namespace birkhoff_cart {
+namespace {
+
+// Recorders of one process that may find their path taken, one after the other (nodelets in one
+// manager): a bound on the own paths tried.
+constexpr int kMostOwnPaths = 100;
+
+}  // namespace
 
 std::string bag_directory(const std::string& bag_path) {
   const std::size_t slash = bag_path.find_last_of('/');
@@ -23,30 +28,14 @@ std::string bag_directory(const std::string& bag_path) {
 
 std::string run_bag_path(const std::string& bag_path, std::uint64_t run) {
   if (run <= 1) return bag_path;
-  const std::string suffix = ".bag";
-  const bool has_suffix =
-      bag_path.size() > suffix.size() && bag_path.compare(bag_path.size() - suffix.size(), suffix.size(), suffix) == 0;
-  const std::string stem = has_suffix ? bag_path.substr(0, bag_path.size() - suffix.size()) : bag_path;
-  return stem + "_run" + std::to_string(run) + (has_suffix ? suffix : "");
+  const std::string stem = bag_stem(bag_path);
+  return stem + "_run" + std::to_string(run) + (stem != bag_path ? ".bag" : "");
 }
 
-std::string kept_path_for(const std::string& bag_path) {
-  struct stat info;
-  if (::stat(bag_path.c_str(), &info) != 0) {
-    throw BagRecorderError("cannot read " + bag_path + ": " + std::strerror(errno));
-  }
-  std::tm utc{};
-  const std::time_t modified = info.st_mtime;
-  ::gmtime_r(&modified, &utc);
-  char stamp[32];
-  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &utc);
-  const std::string suffix = ".bag";
-  const bool has_suffix =
-      bag_path.size() > suffix.size() && bag_path.compare(bag_path.size() - suffix.size(), suffix.size(), suffix) == 0;
-  const std::string stem = (has_suffix ? bag_path.substr(0, bag_path.size() - suffix.size()) : bag_path) + "_" + stamp;
-  std::string kept = stem + suffix;
-  for (int k = 2; ::access(kept.c_str(), F_OK) == 0; ++k) kept = stem + "-" + std::to_string(k) + suffix;
-  return kept;
+std::string own_bag_path(const std::string& bag_path, long process_id, int k) {
+  const std::string stem = bag_stem(bag_path);
+  return stem + "_pid" + std::to_string(process_id) + (k > 1 ? "-" + std::to_string(k) : std::string()) +
+         (stem != bag_path ? ".bag" : "");
 }
 
 std::string disk_space_shortage(const std::string& directory, std::uint64_t free_bytes,
@@ -78,13 +67,22 @@ BagRecorder::BagRecorder(const std::string& path, Compression compression, std::
     const std::string shortage = disk_space_shortage(directory, free_bytes, min_free_disk_space);
     if (!shortage.empty()) throw BagRecorderError("cannot record to " + path + ": " + shortage);
   }
-  if (::access(path.c_str(), F_OK) == 0) {  // an earlier bag: kept under its time, never overwritten
-    const std::string kept = kept_path_for(path);
-    if (std::rename(path.c_str(), kept.c_str()) != 0) {
-      throw BagRecorderError("cannot record to " + path + ": a file is there and cannot be moved to " + kept + ": " +
-                             std::strerror(errno));
+  // The claim first: what is at the path is looked at (and an earlier bag moved) only by the
+  // recorder that holds "<path>.active", so no two recorders ever handle one file.
+  for (int k = 1; !claim_; ++k) {
+    const std::string kind = non_regular_file_kind(path_);
+    if (!kind.empty()) {
+      throw BagRecorderError("cannot record to " + path_ + ": it is " + kind +
+                             ", not a bag file (it is left as it is; ~bag_path names the bag file itself)");
     }
-    earlier_bag_kept_as_ = kept;
+    claim_ = BagFileClaim::claim(path_, crash_record_kept_as_);
+    if (claim_) break;
+    if (k == kMostOwnPaths) {
+      throw BagRecorderError("cannot record to " + taken_path_ + ": it and " + std::to_string(k - 1) +
+                             " other names are being recorded by running recorders");
+    }
+    if (taken_path_.empty()) taken_path_ = path;
+    path_ = own_bag_path(path, static_cast<long>(::getpid()), k);
   }
   BagFileWriter::Compression file_compression = BagFileWriter::Compression::kLz4;
   switch (compression) {
@@ -93,9 +91,15 @@ BagRecorder::BagRecorder(const std::string& path, Compression compression, std::
     case Compression::kBz2: file_compression = BagFileWriter::Compression::kBz2; break;
   }
   try {
-    bag_ = std::make_unique<BagFileWriter>(active_path(), file_compression);
-  } catch (const BagFileError& error) {
-    throw BagRecorderError("cannot open bag " + active_path() + " for writing: " + error.what());
+    keep_earlier_bag();
+    try {
+      bag_ = std::make_unique<BagFileWriter>(claim_->descriptor(), active_path(), file_compression);
+    } catch (const BagFileError& error) {
+      throw BagRecorderError("cannot open bag " + active_path() + " for writing: " + error.what());
+    }
+  } catch (...) {
+    ::unlink(active_path().c_str());  // the claimed file is this recorder's own, and holds nothing yet
+    throw;
   }
   open_ = true;
   writer_ = std::thread(&BagRecorder::write_queued, this);
@@ -172,10 +176,26 @@ void BagRecorder::close() {
                            (failure_ ? " (after: " + *failure_ + ")" : std::string()));
   }
   if (failure_) throw BagRecorderError(*failure_ + " (bag closed with the messages written before)");
+  // Never over a file: one put at the path while recording (by a program that does not claim
+  // paths) is kept aside as an earlier bag would have been.
+  if (::access(path_.c_str(), F_OK) == 0) keep_earlier_bag();
   if (std::rename(active_path().c_str(), path_.c_str()) != 0) {
-    throw BagRecorderError("cannot rename " + active_path() + " to " + path_);
+    throw BagRecorderError("cannot rename " + active_path() + " to " + path_ + ": " + std::strerror(errno));
   }
   finished_ = true;
+  claim_.reset();  // renamed: the lock is no longer needed
+}
+
+void BagRecorder::keep_earlier_bag() {
+  if (::access(path_.c_str(), F_OK) != 0) return;
+  const std::string kind = non_regular_file_kind(path_);
+  if (!kind.empty()) throw BagRecorderError("cannot record to " + path_ + ": it is " + kind + ", not a bag file");
+  const std::string kept = kept_path_for(path_);
+  if (std::rename(path_.c_str(), kept.c_str()) != 0) {
+    throw BagRecorderError("cannot record to " + path_ + ": a file is there and cannot be moved to " + kept + ": " +
+                           std::strerror(errno));
+  }
+  earlier_bag_kept_as_ = kept;
 }
 
 std::string BagRecorder::free_space_note() const {

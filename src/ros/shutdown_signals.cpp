@@ -12,13 +12,22 @@
 #include <string>
 #include <thread>
 
+#include <ros/init.h>
+
 namespace birkhoff_cart {
 namespace {
 
 std::atomic<int> g_shutdown_signals{0};
+std::atomic<int> g_polling_loops{0};  ///< SignalsPolled alive
+static_assert(std::atomic<int>::is_always_lock_free, "the signal handler reads atomics");
 
 extern "C" void on_shutdown_signal(int /*signal*/) {
-  if (g_shutdown_signals.fetch_add(1) == 0) return;  // the first: a clean shutdown by the time loop
+  if (g_shutdown_signals.fetch_add(1) == 0) {
+    // The first: a clean shutdown by the loop that polls the flag; with none polling it, roscpp's
+    // shutdown too (ros::requestShutdown only sets roscpp's flag, as roscpp's own handler does).
+    if (g_polling_loops.load() == 0) ros::requestShutdown();
+    return;
+  }
   // The second: the clean shutdown takes too long (a long step, a slow disk). Only async-signal-safe
   // calls here: say so and leave; a bag being written stays "<path>.active" (`rosbag reindex`).
   static const char kMessage[] =
@@ -35,6 +44,10 @@ void install_shutdown_signal_handlers() {
 }
 
 bool shutdown_signal_received() { return g_shutdown_signals.load() > 0; }
+
+SignalsPolled::SignalsPolled() { ++g_polling_loops; }
+
+SignalsPolled::~SignalsPolled() { --g_polling_loops; }
 
 void end_parent_launch(bool wait) {
   const pid_t parent = ::getppid();

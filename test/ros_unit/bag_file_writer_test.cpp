@@ -1,8 +1,10 @@
 // BagFileWriter (the node's sequential rosbag 2.0 writer): uncompressed it writes the very bytes
 // rosbag::Bag writes for the same messages (several chunks, several types, a topic whose times go
 // back); with every compression rosbag's C++ reader (rosbag::View) and its Python reader
-// (rosbag.Bag) read back each message, in order, without reindexing; a file left without close() is unindexed; misuse and unwritable paths throw naming
-// the problem. No master needed; every file lives in a scratch directory removed at the end.
+// (rosbag.Bag) read back each message, in order, without reindexing; every finished chunk is in
+// the file with its index records before the next one begins (`rosbag reindex` recovers all of
+// them from a killed writer's file); a file left without close() is unindexed; misuse and
+// unwritable paths throw naming the problem. No master needed; every file lives in a scratch directory removed at the end.
 #include <gtest/gtest.h>
 
 #include <stdlib.h>
@@ -204,6 +206,52 @@ INSTANTIATE_TEST_SUITE_P(EveryCompression, BagFileWriterCompression,
                          [](const ::testing::TestParamInfo<BagFileWriter::Compression>& info) {
                            return std::string(BagFileWriter::compression_name(info.param));
                          });
+
+// rosbag's own recovery of a killed recorder's file (`rosbag reindex`, rosbag.Bag.reindex): it
+// keeps every chunk that is followed by its whole index records. Prints the /odom messages recovered.
+constexpr char kPythonReindex[] = R"(import sys, rosbag
+with rosbag.Bag(sys.argv[1], "a", allow_unindexed=True) as bag:
+    for _ in bag.reindex():
+        pass
+with rosbag.Bag(sys.argv[1]) as bag:
+    print(bag.get_message_count("/odom"))
+)";
+
+// A writer killed at any moment (SIGKILL: the stdio buffer is lost, what write(2) handed to the
+// kernel stays) leaves every chunk it finished with the chunk's index records in the file: copied
+// right after a chunk went out (the file grew), the file reindexes to every message written so far.
+TEST_P(BagFileWriterCompression, EveryFinishedChunkIsInTheFileWithItsIndexRecords) {
+  ScratchDirectory scratch;
+  ASSERT_TRUE(scratch.ok());
+  const std::string path = scratch.file("killed.bag.active");
+  const std::string copy = scratch.file("copy.bag.active");
+  const std::string script = scratch.file("reindex.py");
+  const std::string output_path = scratch.file("reindex.out");
+  std::ofstream(script) << kPythonReindex;
+  BagFileWriter writer(path, GetParam(), kSmallChunk);
+  nav_msgs::Odometry odometry;
+  odometry.header.frame_id = "odom";
+  std::size_t size = bytes_of(path).size();
+  int chunks_seen = 0;
+  for (int k = 1; chunks_seen < 3 && k < 10000; ++k) {
+    odometry.header.stamp = ros::Time(0.01 * k);
+    odometry.pose.pose.position.x = 0.01 * k;
+    writer.write("/odom", odometry.header.stamp, odometry);
+    const std::vector<char> on_disk = bytes_of(path);  // what a SIGKILL now would leave
+    if (on_disk.size() == size) continue;
+    size = on_disk.size();
+    ++chunks_seen;
+    // A chunk went out with message k: every message so far is in finished chunks.
+    std::ofstream(copy, std::ios::binary).write(on_disk.data(), static_cast<std::streamsize>(on_disk.size()));
+    const std::string command = "/usr/bin/python3 " + script + " " + copy + " > " + output_path + " 2>&1";
+    const int status = std::system(command.c_str());
+    const std::vector<char> raw = bytes_of(output_path);
+    const std::string output(raw.begin(), raw.end());
+    ASSERT_EQ(status, 0) << command << "\n" << output;
+    EXPECT_EQ(output, std::to_string(k) + "\n") << "after chunk " << chunks_seen << " (message " << k << ")";
+  }
+  EXPECT_EQ(chunks_seen, 3);
+}
 
 TEST(BagFileWriter, AFileNeverClosedIsUnindexed) {
   ScratchDirectory scratch;

@@ -11,6 +11,11 @@
 // piece (roslz4 block size 6, bzip2 level 9 as rosbag), so `rosbag info` and rosbag::View read it
 // as any bag, without reindexing.
 //
+// The file is written with plain write(2) calls, nothing held in a user-space buffer: each chunk
+// goes out with its index records in one writev(2) when it is finished, so the file always ends
+// in whole chunks plus, at most, a cut-off one. A process killed at any moment (SIGKILL, the
+// second signal's _exit) loses only the chunk still in memory, and `rosbag reindex` recovers
+// every chunk finished before (it drops a chunk whose index records are cut short).
 // A write error (disk full) throws BagFileError when a chunk is written; the chunks already on disk
 // stay, the file header still says "unindexed" (index_pos 0) and `rosbag reindex` recovers them.
 // Not thread-safe: one thread writes (BagRecorder's writer thread). No allocation per message once
@@ -18,8 +23,9 @@
 #pragma once
 
 #include <cstdint>
-#include <cstdio>
 #include <cstring>
+#include <initializer_list>
+#include <utility>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -46,6 +52,10 @@ class BagFileWriter {
   /// BagFileError naming the path and the reason.
   BagFileWriter(const std::string& path, Compression compression,
                 std::uint32_t chunk_threshold = kDefaultChunkThreshold);
+  /// Writes into the open, empty file `descriptor` (a copy of it: the caller keeps its own, and
+  /// with it a lock it holds on the file), known as `path` in messages. Throws BagFileError.
+  BagFileWriter(int descriptor, const std::string& path, Compression compression,
+                std::uint32_t chunk_threshold = kDefaultChunkThreshold);
   /// Closes the file handle; without a successful close() the file stays unindexed.
   ~BagFileWriter();
   BagFileWriter(const BagFileWriter&) = delete;
@@ -69,7 +79,7 @@ class BagFileWriter {
   /// Writes the open chunk, the connection and chunk-info records and the final file header, then
   /// closes the file. Throws BagFileError when any of it fails (the file is then left unindexed).
   void close();
-  bool is_open() const { return file_ != nullptr; }
+  bool is_open() const { return descriptor_ >= 0; }
   const std::string& path() const { return path_; }
 
   /// "lz4", "bz2", "none" as rosbag names the chunk compressions.
@@ -105,16 +115,20 @@ class BagFileWriter {
                             const char* definition);
   /// Compresses and writes the open chunk and its index records.
   void write_chunk();
+  /// Writes the version line and the unindexed file header into the file just opened (or throws
+  /// after closing it).
+  void start();
   /// The file header record (padded to 4096 bytes as rosbag's).
   void append_file_header(std::vector<std::uint8_t>& out) const;
   void write_bytes(const std::vector<std::uint8_t>& bytes);
-  void write_bytes(const void* data, std::size_t size);
+  /// Writes the pieces (at most 3), in order, with writev(2): one system call unless it is cut short.
+  void write_bytes(std::initializer_list<std::pair<const void*, std::size_t>> pieces);
   [[noreturn]] void fail(const std::string& what) const;
 
   std::string path_;
   Compression compression_;
   std::uint32_t chunk_threshold_;  ///< [bytes]
-  std::FILE* file_ = nullptr;
+  int descriptor_ = -1;  ///< the open file (write only); -1 once closed
   std::uint64_t position_ = 0;  ///< bytes written to the file so far
   std::uint64_t file_header_position_ = 0;
   std::uint64_t index_position_ = 0;  ///< where the connection and chunk-info records start (0: unindexed)
@@ -126,6 +140,7 @@ class BagFileWriter {
   std::vector<std::uint8_t> chunk_;        ///< uncompressed data of the open chunk
   std::vector<std::uint8_t> compressed_;   ///< the chunk compressed (reused)
   std::vector<std::uint8_t> records_;      ///< record headers and index records being written (reused)
+  std::vector<std::uint8_t> chunk_header_;  ///< the chunk record's header and data length (reused)
 };
 
 }  // namespace birkhoff_cart

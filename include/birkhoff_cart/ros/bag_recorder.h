@@ -2,6 +2,12 @@
 // bag is "<path>.active" (like `rosbag record`); close() renames it to <path>, so a bag at <path>
 // is always complete and readable by `rosbag info` and python rosbag.
 //
+// One file per recorder (BagFileClaim): "<path>.active" is created and locked for as long as the
+// recorder writes it. A recorder that finds it locked by another (two launches on one master)
+// records to "<stem>_pid<its process id>.bag" instead; an unlocked one (a killed run's) is kept
+// aside under its time, like an earlier bag at <path>; a path that exists and is not a regular
+// file is refused. Nothing another recorder writes is ever renamed, truncated or written over.
+//
 // Disk space: before opening, the recorder can refuse a directory with less free space than a
 // minimum (cart_sim's ~min_free_disk_space), so a node never starts a record it cannot keep. A disk
 // that fills during the run makes write() (or close()) throw; close() then closes what it can.
@@ -19,7 +25,6 @@
 #include <memory>
 #include <mutex>
 #include <optional>
-#include <stdexcept>
 #include <string>
 #include <thread>
 #include <variant>
@@ -32,15 +37,10 @@
 #include <tf2_msgs/TFMessage.h>
 
 #include "birkhoff_cart/IntegrationError.h"
+#include "birkhoff_cart/ros/bag_file_claim.h"
 #include "birkhoff_cart/ros/bag_file_writer.h"
 
 namespace birkhoff_cart {
-
-/// The bag cannot be opened or written (the message names the path and the reason).
-class BagRecorderError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 /// The directory that holds `bag_path` ("." for a bare file name, "/" for a file at the root).
 std::string bag_directory(const std::string& bag_path);
@@ -59,10 +59,10 @@ std::string disk_space_shortage(const std::string& directory, std::uint64_t free
 /// (statvfs: f_bavail × f_frsize). Throws BagRecorderError naming the directory when statvfs fails.
 std::uint64_t free_disk_space(const std::string& directory);
 
-/// The name an earlier bag at `bag_path` is kept under: "<stem>_<its modification time, UTC,
-/// YYYYMMDD-HHMMSS>.bag", with "-2", "-3", ... after the time when that name is taken too.
-/// Throws BagRecorderError when the file cannot be read (stat).
-std::string kept_path_for(const std::string& bag_path);
+/// Where a recorder whose `bag_path` is taken by another running recorder records instead:
+/// "<stem>_pid<process id>.bag" (k = 1), "<stem>_pid<process id>-<k>.bag" after (several
+/// recorders of one process, nodelets in one manager). Keeps a path without ".bag" suffixless.
+std::string own_bag_path(const std::string& bag_path, long process_id, int k);
 
 class BagRecorder {
  public:
@@ -75,12 +75,15 @@ class BagRecorder {
   /// Messages queued before the waiting writer thread is woken (close() wakes it for the rest).
   static constexpr std::size_t kWakeBatch = 256;
 
-  /// Opens "<path>.active" for writing and starts the writer thread. A file already at `path` (an
-  /// earlier run's bag) is never overwritten: it is first renamed to kept_path_for() of it, and
-  /// earlier_bag_kept_as() says where. Throws BagRecorderError when
-  /// it cannot (missing or unwritable directory, empty path, ...) or, with `min_free_disk_space` >
-  /// 0 [bytes], when the bag's directory has less free space than that (checked before anything
-  /// is created).
+  /// Claims "<path>.active" (BagFileClaim), opens it for writing and starts the writer thread.
+  /// When another running recorder holds it, records to own_bag_path() instead (taken_path()
+  /// says which path was taken). A file already at the path recorded to (an earlier run's bag) is
+  /// never overwritten: it is first renamed to kept_path_for() of it, and earlier_bag_kept_as()
+  /// says where; crash_record_kept_as() says where a killed run's "<path>.active" went. Throws
+  /// BagRecorderError naming the path and the reason when it cannot record (empty path, a path
+  /// that is a directory or another non-regular file, a missing or unwritable directory, ...) or,
+  /// with `min_free_disk_space` > 0 [bytes], when the bag's directory has less free space than
+  /// that (checked before anything is created or moved).
   BagRecorder(const std::string& path, Compression compression = Compression::kLz4,
               std::uint64_t min_free_disk_space = 0);
   /// Closes the bag (see close()); never throws.
@@ -125,8 +128,10 @@ class BagRecorder {
   void close();
   bool is_open() const { return open_; }
 
-  /// The final path of the bag (valid after close()).
+  /// The final path of the bag: the path asked for, or own_bag_path() of it when that was taken.
   const std::string& path() const { return path_; }
+  /// The path asked for when another running recorder held it ("" otherwise).
+  const std::string& taken_path() const { return taken_path_; }
   /// The path written while open.
   std::string active_path() const { return path_ + ".active"; }
   /// Where the bag is now: path() after a successful close(), active_path() otherwise (still
@@ -134,6 +139,8 @@ class BagRecorder {
   std::string current_path() const { return finished_ ? path_ : active_path(); }
   /// Where the file found at path() when recording began went ("" when there was none).
   const std::string& earlier_bag_kept_as() const { return earlier_bag_kept_as_; }
+  /// Where a killed run's unlocked "<path>.active" found when recording began went ("" when none).
+  const std::string& crash_record_kept_as() const { return crash_record_kept_as_; }
   /// Messages written to the file per topic (complete after close()).
   std::map<std::string, std::uint64_t> message_counts() const;
 
@@ -155,8 +162,14 @@ class BagRecorder {
   /// "" when statvfs fails.
   std::string free_space_note() const;
 
+  /// Keeps a regular file found at path_ under kept_path_for() (its name in earlier_bag_kept_as_).
+  void keep_earlier_bag();
+
   std::string path_;
+  std::string taken_path_;
   std::string earlier_bag_kept_as_;
+  std::string crash_record_kept_as_;
+  std::unique_ptr<BagFileClaim> claim_;  ///< "<path_>.active", locked until it is renamed to path_
   std::unique_ptr<BagFileWriter> bag_;
   bool open_ = false;      ///< accepting writes (mutex_)
   bool finished_ = false;  ///< closed and renamed to path_

@@ -20,7 +20,9 @@ class RunRecord {
  public:
   /// Opens the bag of run 1 at run_bag_path(`bag_path`, 1) (`compression`: none, lz4, bz2;
   /// `min_free_disk_space` [bytes]: refused below it). Throws BagRecorderError or
-  /// std::invalid_argument naming the problem; warns when an earlier bag there was kept aside.
+  /// std::invalid_argument naming the problem; warns when an earlier bag or a killed run's
+  /// .active there was kept aside, and when another node records to `bag_path` (this node then
+  /// records to own_bag_path() of it, and its later runs beside that).
   RunRecord(std::string bag_path, const std::string& compression, std::uint64_t min_free_disk_space);
 
   /// Queues one message at `stamp` while the record is unfailed; a failure is kept, not thrown.

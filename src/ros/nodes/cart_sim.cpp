@@ -19,8 +19,15 @@ namespace {
 int run_node(ros::NodeHandle& node_handle) {
   try {
     birkhoff_cart::CartSimNode node(node_handle, ros::NodeHandle("~"));
+    // The time loop polls the signal flag: a signal from here on leaves roscpp up for its clean end.
+    const birkhoff_cart::SignalsPolled polled;
     return node.run();
   } catch (const birkhoff_cart::NodeStartupError& error) {
+    if (birkhoff_cart::shutdown_signal_received()) {
+      // roscpp was shut down by the signal while the node started (its log output with it).
+      std::fprintf(stderr, "cart_sim: stopped by a shutdown signal while starting\n");
+      return birkhoff_cart::CartSimNode::kExitFinished;
+    }
     ROS_FATAL("cart_sim: %s", error.what());
     return birkhoff_cart::CartSimNode::kExitStartupFailure;
   } catch (const std::exception& error) {  // run() catches its own; this is construction or teardown
@@ -56,11 +63,10 @@ int main(int argc, char** argv) {
       unheard_clock_holder = node_handle.advertise<rosgraph_msgs::Clock>(birkhoff_cart::kUnheardClockTopic, 1);
     }
     const int exit_code = run_node(node_handle);
-    bool end_launch = false;
-    ros::param::get("~end_launch", end_launch);
-    if (end_launch && exit_code == birkhoff_cart::CartSimNode::kExitFinished &&
-        !birkhoff_cart::shutdown_signal_received()) {
-      birkhoff_cart::end_parent_launch(true);
+    if (exit_code == birkhoff_cart::CartSimNode::kExitFinished && !birkhoff_cart::shutdown_signal_received()) {
+      bool end_launch = false;
+      ros::param::get("~end_launch", end_launch);
+      if (end_launch) birkhoff_cart::end_parent_launch(true);
     }
     return exit_code;
   });
