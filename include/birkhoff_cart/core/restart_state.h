@@ -7,9 +7,10 @@
 //     coordinate (at x = 1e20 m one ulp is 16 km: the cart would never move);
 //   - speeds one step resolves: in a step of h the front axle turns by at most kLargestStepFraction
 //     rad (|ω2| h <= 0.1 rad) and the hinge travels at most kLargestStepFraction of the wheelbase
-//     (|ω1| h <= 0.1 l, so the body turns by at most 0.1 rad: θ̇ = ω1 sin χ / l). Every integrator
-//     of the registry steps 3000 steps from such states on the shipped scenes; at 1 rad per step a
-//     jackknifed cart broke within 10 steps (a singular Newton matrix, a non-finite π1);
+//     (|ω1| h <= 0.1 l, so the body turns by at most 0.1 rad: θ̇ = ω1 sin χ / l). From states at
+//     0.5, 0.9 and 1 times these limits, χ from 0 to π, every member of the registry stepped 3000
+//     steps without a failure on six shipped scenes (seven members on the other seven); at 1 rad
+//     per step a jackknifed cart broke within 10 steps (a singular Newton matrix, a non-finite π1);
 //   - no singular steering angle within the next step (the paper's special case, docs/hard_cases.md §1);
 //   - a steering angle within the scene's end stops.
 // The trial step from the state (a stepper of its own) is Simulation::restart_from's.
