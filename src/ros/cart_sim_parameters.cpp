@@ -12,12 +12,23 @@
 namespace birkhoff_cart {
 namespace {
 
+/// What a parameter of type T must be, for a refusal.
+template <class T>
+const char* expected_type();
+template <>
+const char* expected_type<bool>() { return "a bool (true or false)"; }
+template <>
+const char* expected_type<std::string>() { return "a string"; }
+template <>
+const char* expected_type<std::vector<std::string>>() { return "a list of strings"; }
+
 template <class T>
 T read_parameter(const ros::NodeHandle& node, const std::string& name, const T& fallback) {
   T value;
   if (node.getParam(name, value)) return value;
   if (node.hasParam(name)) {
-    throw std::invalid_argument("parameter " + node.resolveName(name) + " has the wrong type");
+    throw std::invalid_argument("parameter " + node.resolveName(name) + " must be " + expected_type<T>() + ", got " +
+                                describe_parameter_value(node, name));
   }
   return fallback;
 }
@@ -62,7 +73,7 @@ const std::vector<std::string>& cart_sim_parameter_names() {
       "scene", "integrator", "step_size", "publish_rate", "fast", "real_time_factor", "duration", "command_timeout",
       "max_steering_torque", "max_drive_torque", "lockstep", "lockstep_topics", "lockstep_timeout", "bag_path",
       "record_wall_time", "bag_compression", "min_free_disk_space", "summary_path", "frame_prefix", "odom_frame",
-      "base_frame", "world_frame", "publish_world_tf", "pose_covariance_diagonal", "twist_covariance_diagonal", "publish_tf", "publish_clock",
+      "base_frame", "world_frame", "ground_truth_frame", "publish_world_tf", "pose_covariance_diagonal", "twist_covariance_diagonal", "publish_tf", "publish_clock",
       "follow_clock", "start_paused", "diagnostic_period", "energy_residual_warn", "energy_residual_error",
       "p2_residual_warn", "p2_residual_error", "constraint_residual_warn", "constraint_residual_error", "end_launch",
       "accuracy/",
@@ -123,12 +134,17 @@ CartSimParameters load_parameters(const ros::NodeHandle& private_node) {
   parameters.frame_prefix = read_parameter<std::string>(p, "frame_prefix", parameters.frame_prefix);
   parameters.frames = ros_conversions::prefixed_frames(
       parameters.frame_prefix, read_parameter<std::string>(p, "odom_frame", parameters.frames.odom),
-      read_parameter<std::string>(p, "base_frame", parameters.frames.base_link));
+      read_parameter<std::string>(p, "base_frame", parameters.frames.base_link),
+      read_parameter<std::string>(p, "ground_truth_frame", parameters.frames.ground_truth));
   require(parameters.frames.odom != parameters.frames.base_link, "~odom_frame and ~base_frame must differ");
+  require(parameters.frames.ground_truth != parameters.frames.odom &&
+              parameters.frames.ground_truth != parameters.frames.base_link,
+          "~ground_truth_frame must differ from the odom and base frames (one frame pair, one source)");
   parameters.frames.world = read_parameter<std::string>(p, "world_frame", parameters.frames.world);
   require(!parameters.frames.world.empty() && parameters.frames.world != parameters.frames.odom &&
-              parameters.frames.world != parameters.frames.base_link,
-          "~world_frame must be a frame name other than the odom and base frames");
+              parameters.frames.world != parameters.frames.base_link &&
+              parameters.frames.world != parameters.frames.ground_truth,
+          "~world_frame must be a frame name other than the odom, base and ground truth frames");
   parameters.publish_world_tf = read_parameter<bool>(p, "publish_world_tf", parameters.publish_world_tf);
   parameters.odometry_covariance.pose_diagonal =
       read_variances(p, "pose_covariance_diagonal", parameters.odometry_covariance.pose_diagonal);
