@@ -560,7 +560,7 @@ bool CartSimNode::start_on_leader_clock_if_behind() {
       restart_run("the start on the leader's clock", RunStart::kWhole, [&] { simulation_->restart_from(target); },
                   refusal)) {
     ROS_INFO("cart_sim: the leader's /clock is at t = %s s: this cart's run starts on it, at t = %s s (not in "
-             "the leader's past, which it would replay in a burst of repeated stamps)",
+             "the leader's past, which it would replay in a burst)",
              format_seconds(leader_time).c_str(), format_seconds(start).c_str());
     return true;
   }

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """rostest cart_sim_reconfigure: cart_sim's limits and accuracy guard change while it runs, through
 dynamic_reconfigure; a bad set is refused and the running settings stay. A refusal is seen: the set
-answers with the settings in force and a WARN line names the value typed (issue 38: the cfg's
+answers with the settings in force and a WARN line names the value typed (before, the cfg's
 limits clamped -5 to 0 before the node saw it, and cmd_vel_controller's steering_max_angle 2.0
 silently became 1.57)."""
 import threading

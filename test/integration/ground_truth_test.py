@@ -81,7 +81,7 @@ class GroundTruth(unittest.TestCase):
         for odom, truth in zip(self.series("exact", "odom"), self.series("exact", "ground_truth")):
             self.assertEqual(key_of(odom), key_of(truth), f"t = {odom.header.stamp.to_sec()} s")
             self.assertEqual((odom.header.frame_id, odom.child_frame_id), ("odom", "base_link"))
-            # Its own child frame (issue 38): map -> base_link would have two sources, the ground truth
+            # Its own child frame: map -> base_link would have two sources, the ground truth
             # and tf's map -> odom -> base_link, which disagree as soon as a sensor is on.
             self.assertEqual((truth.header.frame_id, truth.child_frame_id), ("map", "base_link_ground_truth"))
             self.assertEqual(max(abs(c) for c in truth.pose.covariance), 0.0)

@@ -55,7 +55,7 @@ TEST(SteeringDriver, RefusesARateItsTimerCannotHold) {
 }
 
 TEST(CartSim, NamesTheTypeAParameterMustHave) {
-  // Regression (issue 38): `_fast:=1` (an int) said only "has the wrong type".
+  // Regression: `_fast:=1` (an int) said only "has the wrong type".
   const std::string scene = std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/default.yaml";
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"_fast:=1", "parameter /typed_sim/fast must be a bool (true or false), got the int 1"},

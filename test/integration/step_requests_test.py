@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""rostest step_requests: cart_sim's ~step cannot run away (docs/ros_interface.md, "~step"; issue 38).
+"""rostest step_requests: cart_sim's ~step cannot run away (docs/ros_interface.md, "~step").
 Before the fix a `~step 4294967295` stepped for hours, ~pause and ~reset answered while the steps
 went on, a second call waited behind the first, refusals answered t = 0 and unpausing during a step
 stopped /clock for as long as the step had run ahead."""

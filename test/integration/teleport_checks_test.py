@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """rostest teleport_checks: ~set_state and initialpose are checked before they are committed
-(docs/ros_interface.md, "~set_state", "initialpose"; issue 38). Before the fix `~set_state 1 1 0 0
+(docs/ros_interface.md, "~set_state", "initialpose"). Before the fix `~set_state 1 1 0 0
 1e200 0` answered success and the next step killed the node; x = 1e20, heading and chi 1e300 and
 1e6 m/s were accepted; an initialpose with an empty frame was taken as odom, and its NaN refusal did
 not name the field."""

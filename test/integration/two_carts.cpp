@@ -144,7 +144,7 @@ TEST(TwoCarts, EachCartHasItsOwnTreeAndOdometryUnderOneClock) {
   EXPECT_GT(std::abs(cart2.odometry[expected - 1].pose.pose.position.x - cart2.odometry.front().pose.pose.position.x),
             1.0);
 
-  // The follower alone reset (issue 38): its scene starts again at the leader's current time, on
+  // The follower alone reset: its scene starts again at the leader's current time, on
   // its publish grid, and goes on from there. Before, it replayed the leader's past in a burst
   // (stamps from t0 again: TF_REPEATED_DATA in every tf listener).
   ASSERT_TRUE(birkhoff_cart_test::wait_for(

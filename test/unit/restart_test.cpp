@@ -165,7 +165,7 @@ TEST(Restart, RefusesByNameAndLeavesTheRunUntouched) {
 }
 
 TEST(Restart, RefusesStatesNoStepResolvesByName) {
-  // Regression (issue 38): ~set_state 1 1 0 0 1e200 0 was accepted and the next step killed the node;
+  // Regression: ~set_state 1 1 0 0 1e200 0 was accepted and the next step killed the node;
   // x = 1e20 (the cart never moved again), heading and chi 1e300, 1e6 m/s were accepted too.
   const Scene scene = load("default");  // h = 10 ms, l = 1.05 m
   struct Case {
