@@ -181,7 +181,7 @@ MUTATIONS = [
         "a follower's run starts at its scene's t0 however far the leader's clock is ahead",
         "src/core/node_logic/run_timeline.cpp",
         "if (!(leader_time - scene_start > longest_catch_up)) return scene_start;",
-        "if (true) return scene_start;",
+        "if (!(leader_time - scene_start > longest_catch_up) || true) return scene_start;",
         [("run_timeline_test", "*")],
     ),
     Mutation(
