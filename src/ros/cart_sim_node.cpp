@@ -408,7 +408,7 @@ int CartSimNode::run() {
     // closed, exit 4; never std::terminate with the record left unfinished.
     internal_error = error.what();
   }
-  step_requests_->end(simulation_->state().time);
+  step_requests_->end(simulation_->state().time, stop_requested());
 
   if (!internal_error && !step_failure_ && !record_failed() && !stop_requested() &&
       (publisher_->listened() || reports_->diagnostics_listened())) {
@@ -481,14 +481,16 @@ void CartSimNode::wait_for_controllers() {
   const auto connected = [this] {
     return commands_->controllers_connected() && publisher_->joint_state_subscribers() > 0;
   };
-  Clock::time_point next_note = after(parameters_.lockstep_timeout);
+  // A note every ~lockstep_timeout, at most one a second (a tiny timeout would flood the log).
+  const double note_interval = std::max(parameters_.lockstep_timeout, 1.0);  // [s of wall time]
+  Clock::time_point next_note = after(note_interval);
   while (!connected() && !stop_requested()) {
     callback_queue_.wait_until(after(0.01));
     process_callbacks();
     if (Clock::now() >= next_note) {
       ROS_WARN("cart_sim: lockstep: waiting for a controller (publishers on %s and a joint_states subscriber)",
                commands_->expected_topics().c_str());
-      next_note = after(parameters_.lockstep_timeout);
+      next_note = after(note_interval);
     }
   }
 }
@@ -503,7 +505,8 @@ void CartSimNode::wait_for_commands(double time) {
     const Clock::time_point now = Clock::now();
     if (now >= give_up) {
       ++lockstep_timeouts_;
-      ROS_WARN("cart_sim: lockstep: no answer on %s within %g s of wall time after t = %.6g s; going on "
+      // Counted each time; said at most once a second (a tiny ~lockstep_timeout would flood the log).
+      ROS_WARN_THROTTLE(1.0, "cart_sim: lockstep: no answer on %s within %g s of wall time after t = %.6g s; going on "
                "(%lu timeouts so far)",
                commands_->unanswered_topics().c_str(), parameters_.lockstep_timeout, time,
                static_cast<unsigned long>(lockstep_timeouts_));

@@ -33,6 +33,10 @@ T read_parameter(const ros::NodeHandle& node, const std::string& name, const T& 
   return fallback;
 }
 
+/// The most publish (or diagnostic) instants per second of scene time [Hz]: the instant index k
+/// stays exact in a double (2^53) over the 2^32 s of ROS time.
+constexpr double kHighestInstantRate = 1e6;
+
 void require(bool condition, const std::string& message) {
   if (!condition) throw std::invalid_argument(message);
 }
@@ -94,7 +98,10 @@ CartSimParameters load_parameters(const ros::NodeHandle& private_node) {
   require(std::isfinite(parameters.step_size) && parameters.step_size >= 0.0,
           "~step_size must be >= 0 s (0 = the scene's)");
   parameters.publish_rate = read_double_parameter(p, "publish_rate", parameters.publish_rate);
-  require(std::isfinite(parameters.publish_rate) && parameters.publish_rate > 0.0, "~publish_rate must be > 0 Hz");
+  // An instant's index k (t0 + k/rate) stays exact in a double over ROS time's 2^32 s up to 2^21 Hz.
+  require(std::isfinite(parameters.publish_rate) && parameters.publish_rate > 0.0 &&
+              parameters.publish_rate <= kHighestInstantRate,
+          "~publish_rate must be > 0 and <= 1e6 Hz, got " + format_seconds(parameters.publish_rate));
   parameters.fast = read_parameter<bool>(p, "fast", parameters.fast);
   parameters.real_time_factor = read_double_parameter(p, "real_time_factor", parameters.real_time_factor);
   require(std::isfinite(parameters.real_time_factor) && parameters.real_time_factor >= 0.0,
@@ -157,8 +164,8 @@ CartSimParameters load_parameters(const ros::NodeHandle& private_node) {
           "~follow_clock needs ~publish_clock false: a node cannot follow the clock it drives itself");
   parameters.start_paused = read_parameter<bool>(p, "start_paused", parameters.start_paused);
   parameters.diagnostic_period = read_double_parameter(p, "diagnostic_period", parameters.diagnostic_period);
-  require(std::isfinite(parameters.diagnostic_period) && parameters.diagnostic_period > 0.0,
-          "~diagnostic_period must be > 0 s");
+  require(std::isfinite(parameters.diagnostic_period) && parameters.diagnostic_period >= 1.0 / kHighestInstantRate,
+          "~diagnostic_period must be >= 1e-6 s, got " + format_seconds(parameters.diagnostic_period));
   return parameters;
 }
 }  // namespace birkhoff_cart

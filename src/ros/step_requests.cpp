@@ -25,7 +25,7 @@ StepRequests::StepRequests(ros::NodeHandle& private_node, Refusal refusal, std::
 }
 
 StepRequests::~StepRequests() {
-  end(time_);
+  end(time_, true);  // the node goes away
   spinner_->stop();
   service_.shutdown();
 }
@@ -67,8 +67,8 @@ bool StepRequests::serve(StepRun::Request& request, StepRun::Response& response)
   const std::string at = "; t = " + format_seconds(response.time) + " s";
   if (response.success) {
     response.message = "took " + count + at + ", paused";
-  } else if (!cancelled_by_.empty()) {
-    response.message = "cancelled by " + cancelled_by_ + " after " + count + at;
+  } else if (!cancelled_by_.empty() || shut_down_) {
+    response.message = "cancelled by " + (shut_down_ ? std::string("shutdown") : cancelled_by_) + " after " + count + at;
   } else {
     response.message = "ran out after " + count + at + " (the run ended or a step failed)";
   }
@@ -96,10 +96,11 @@ void StepRequests::cancel(const std::string& reason, double time) {
   condition_.notify_all();
 }
 
-void StepRequests::end(double time) {
+void StepRequests::end(double time, bool shutdown) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     loop_over_ = true;
+    shut_down_ = shutdown;
     time_ = time;
   }
   condition_.notify_all();

@@ -46,8 +46,9 @@ class StepRequests {
   /// The run moved to scene time `time` [s] by `reason` (~pause, ~reset, a teleport): an open
   /// request takes no further step and is answered now, naming `reason`; later answers give `time`.
   void cancel(const std::string& reason, double time);
-  /// The run loop has ended at scene time `time` [s]: an open request returns with the steps taken.
-  void end(double time);
+  /// The run loop has ended at scene time `time` [s] (`shutdown`: stopped by a shutdown, not at the
+  /// run's end or a failed step): an open request returns with the steps taken, naming which.
+  void end(double time, bool shutdown = false);
 
  private:
   bool serve(StepRun::Request& request, StepRun::Response& response);
@@ -63,6 +64,7 @@ class StepRequests {
   std::atomic<double> time_;    ///< the scene time after the last step or move [s]
   bool request_open_ = false;   ///< guarded by mutex_
   bool loop_over_ = false;      ///< guarded by mutex_
+  bool shut_down_ = false;      ///< the loop ended by a shutdown; guarded by mutex_
   std::uint64_t steps_taken_ = 0;  ///< of the open request; guarded by mutex_
   std::string cancelled_by_;       ///< why the open request was cancelled ("" if not); guarded by mutex_
 };
