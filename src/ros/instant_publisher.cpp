@@ -6,13 +6,22 @@
 
 namespace birkhoff_cart {
 
+namespace {
+
+/// Messages each subscriber's connection may hold per topic of an instant: a ~step call runs its
+/// steps as fast as they go, so a burst of up to this many instants reaches a subscriber that drains
+/// it a little later (with 50, a loaded machine's Python subscriber lost 8 of a 60-instant burst).
+constexpr std::uint32_t kInstantQueue = 1000;
+
+}  // namespace
+
 InstantPublisher::InstantPublisher(ros::NodeHandle& node, ros::NodeHandle& private_node,
                                    const CartSimParameters& parameters, double start_time)
     : parameters_(parameters),
-      odometry_(node, "odom", 50),
-      ground_truth_(node, "ground_truth", 50),
-      joints_(node, "joint_states", 50),
-      integration_error_(private_node, "integration_error", 50),
+      odometry_(node, "odom", kInstantQueue),
+      ground_truth_(node, "ground_truth", kInstantQueue),
+      joints_(node, "joint_states", kInstantQueue),
+      integration_error_(private_node, "integration_error", kInstantQueue),
       messages_(parameters.frames, parameters.odometry_covariance) {
   // /clock through a NodeHandle whose own remapping keeps it /clock: main() remaps roscpp's internal
   // /clock subscription of this process away (kUnheardClockTopic), so the node does not hear back
