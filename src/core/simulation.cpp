@@ -9,6 +9,7 @@
 #include "birkhoff_cart/core/actuators/torque_actuator.h"
 #include "birkhoff_cart/core/effect_library.h"
 #include "birkhoff_cart/core/reference_solution.h"
+#include "birkhoff_cart/core/restart_state.h"
 #include "birkhoff_cart/core/singular_steering.h"
 
 namespace birkhoff_cart {
@@ -195,43 +196,50 @@ void Simulation::reset() {
 }
 
 void Simulation::restart_from(const CartState& initial_state) {
-  const CartState& s = initial_state;
-  const double fields[] = {s.time, s.x, s.y, s.heading, s.steering_angle, s.arc_length, s.forward_speed,
-                           s.steering_rate, s.wheel_spin_angle[0], s.wheel_spin_angle[1], s.wheel_spin_angle[2],
-                           s.wheel_spin_angle[3]};
-  const char* names[] = {"time", "x", "y", "heading", "steering_angle", "arc_length", "forward_speed",
-                         "steering_rate", "wheel_spin_angle[0]", "wheel_spin_angle[1]", "wheel_spin_angle[2]",
-                         "wheel_spin_angle[3]"};
-  for (std::size_t i = 0; i < sizeof(fields) / sizeof(fields[0]); ++i) {
-    if (!std::isfinite(fields[i])) {
-      std::ostringstream message;
-      message << "restart state: " << names[i] << " must be finite, got " << fields[i];
-      throw std::invalid_argument(message.str());
-    }
-  }
-  try {
-    check_singular_steering(model_, initial_state, scene_.integrator.step_size);
-  } catch (const StepError& error) {
-    throw std::invalid_argument(std::string("restart state: ") + error.what());
-  }
-  if (const auto& stops = effects_.end_stops()) {
-    if (stops->penetration(initial_state.steering_angle) > 0.0) {
-      std::ostringstream message;
-      message << "restart state: steering_angle " << initial_state.steering_angle << " rad lies beyond the end stops at +-"
-              << stops->settings().angle << " rad";
-      throw std::invalid_argument(message.str());
-    }
-  }
+  check_restart_state(model_, effects_, initial_state, scene_.integrator.step_size);
   Scene restarted = scene_;
   restarted.initial_state = initial_state;
   // The balances' integrals run from the run's start (docs eq. (3.7), (3.8)): a restart is one.
   restarted.initial_state.applied_work = 0.0;
   restarted.initial_state.steering_impulse = 0.0;
+  check_trial_step(restarted);
   start_run(std::move(restarted));
   // The actuators keep their torques and pending inputs (a teleport moves the cart, not its motors).
   if (effects_.steering_actuator()) effects_.steering_actuator()->retime(scene_.initial_state.time);
   if (effects_.drive_actuator()) effects_.drive_actuator()->retime(scene_.initial_state.time);
   if (effects_.end_stops()) effects_.end_stops()->set_contact(SteeringEndStops::Contact::kNone);
+}
+
+void Simulation::check_trial_step(const Scene& run_scene) {
+  // The run's own stepper starts fresh (start_run): the trial has one of its own. End stops take
+  // no contact from the state before (as after the commit below).
+  SteeringEndStops* const stops = effects_.end_stops().get();
+  const SteeringEndStops::Contact contact = stops ? stops->contact() : SteeringEndStops::Contact::kNone;
+  if (stops) stops->set_contact(SteeringEndStops::Contact::kNone);
+  const double h = run_scene.integrator.step_size;  // [s]
+  std::string failure;
+  try {
+    std::unique_ptr<CartStepper> stepper = make_cart_stepper(integrator_settings(run_scene), model_, effects_);
+    StepStatistics statistics;
+    const CartState& start = run_scene.initial_state;
+    stepper->prepare(start, statistics);
+    CartState next = start;
+    stepper->step(next, h, statistics);
+    check_singular_steering(model_, start, h, &next);
+    const double energy = model_.energy(next);  // [J]
+    if (!std::isfinite(energy)) failure = "its kinetic energy T* becomes " + std::to_string(energy) + " J";
+  } catch (const StepError& error) {
+    failure = error.what();
+  } catch (...) {
+    if (stops) stops->set_contact(contact);
+    throw;
+  }
+  if (stops) stops->set_contact(contact);
+  if (!failure.empty()) {
+    std::ostringstream message;
+    message << "restart state: a trial step of h = " << h << " s from it fails: " << failure;
+    throw std::invalid_argument(message.str());
+  }
 }
 
 void Simulation::start_run(Scene run_scene) {

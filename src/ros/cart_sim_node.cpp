@@ -1,11 +1,16 @@
-// cart_sim's construction and time loop (see cart_sim_node.h). It never computes physics: the
-// state, the diagnostics and the rates all come from the core.
+// cart_sim's node (see cart_sim_node.h): construction, the time loop, the one restart of the run
+// (~reset, ~set_state and initialpose, a follower moved onto its leader's clock), ~pause, the
+// pacing (callbacks between steps, real-time deadlines, pauses, the lockstep barrier, following a
+// leader's /clock) and the publish instant. It never computes physics: the state, the diagnostics
+// and the rates all come from the core.
 #include "birkhoff_cart/ros/cart_sim_node.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <sstream>
+#include <thread>
 
 #include <rosgraph_msgs/Clock.h>
 
@@ -17,10 +22,20 @@
 namespace birkhoff_cart {
 namespace {
 
-constexpr double kLastInstantLinger = 0.1;  // [s of wall time] after a run that ended well
+using Clock = WallClockPacing::Clock;
 
-// What roscpp's own /clock subscription does, for a node that does not publish /clock.
-void hear_clock(const rosgraph_msgs::Clock::ConstPtr& clock) { ros::Time::setNow(clock->clock); }
+constexpr double kLastInstantLinger = 0.1;  // [s of wall time] after a run that ended well
+// Longest single sleep [s]: a SIGINT/SIGTERM (whose handler cannot wake a condition) is seen
+// within this time.
+constexpr double kLongestSleep = 0.1;
+/// How long a lockstep barrier polls for the controllers' answers before it sleeps [µs].
+constexpr int kLockstepSpinMicroseconds = 200;
+/// How long a follower waits for a /clock at a time before it looks at its callbacks again [s].
+constexpr double kClockPoll = 0.01;
+
+Clock::time_point after(double seconds) {
+  return Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+}
 
 }  // namespace
 
@@ -55,40 +70,11 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   }
 
   const double start_time = simulation_->state().time;
-  // Scene time t is ROS time t, and ROS time cannot be negative: refuse here, not at the first
-  // /clock (which would end the run in std::terminate with the bag left unfinished).
-  if (!(start_time >= 0.0)) {
-    throw NodeStartupError("scene " + parameters_.scene_path + " starts at t = " + format_seconds(start_time) +
-                           " s: cart_sim publishes scene time as ROS time, which must be >= 0");
-  }
-  if (parameters_.duration < 0.0) {
-    run_duration_ = simulation_->scene().duration;
-  } else if (parameters_.duration == 0.0 || std::isinf(parameters_.duration)) {
-    run_duration_ = std::numeric_limits<double>::infinity();
-  } else {
-    run_duration_ = parameters_.duration;
-  }
-  loaded_start_time_ = start_time;
-  end_time_ = std::numeric_limits<double>::infinity();
-  if (std::isfinite(run_duration_)) {
-    // The same plan as cart_simulate's (the scene's own duration was already checked by Simulation).
-    try {
-      end_time_ = plan_steps(start_time, run_duration_, simulation_->step_size()).end_time;
-    } catch (const TimeLimitError& error) {
-      const bool from_parameter = parameters_.duration > 0.0 && error.key() == "duration";
-      const std::string key = from_parameter ? std::string("~duration") : "scene key '" + error.key() + "'";
-      throw NodeStartupError("the run of scene " + parameters_.scene_path + " cannot be cut into steps: " + key +
-                             ": " + error.problem());
-    }
-  }
-  // ros::Time holds 32-bit seconds: a stamp at or past 2^32 s throws in roscpp. Refuse such a run
-  // here by name; a run without end that gets there stops cleanly with exit 4 (run()).
-  if (!(start_time < ros_conversions::kLatestRosTime) ||
-      (std::isfinite(end_time_) && !(end_time_ < ros_conversions::kLatestRosTime))) {
-    throw NodeStartupError("scene " + parameters_.scene_path + " runs from t = " + format_seconds(start_time) +
-                           " s to t = " + format_seconds(end_time_) +
-                           " s: cart_sim publishes scene time as ROS time, which ends before 2^32 s = " +
-                           format_seconds(ros_conversions::kLatestRosTime) + " s");
+  try {
+    timeline_.emplace(parameters_.duration, simulation_->scene().duration, simulation_->step_size(),
+                      parameters_.scene_path, start_time);
+  } catch (const RunTimelineError& error) {
+    throw NodeStartupError(error.what());
   }
   // Stamps are scene time; a node on wall time would see them decades in the past. A follower of
   // another node's /clock needs that clock.
@@ -105,10 +91,7 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
              "birkhoff_cart does, but lockstep.launch, whose loop reads only stamps).", format_seconds(start_time).c_str());
   }
   publish_period_ = 1.0 / parameters_.publish_rate;
-  double real_time_factor = parameters_.real_time_factor;
-  if (!parameters_.fast && real_time_factor == 0.0) real_time_factor = 1.0;
-  if (parameters_.follow_clock) real_time_factor = 0.0;  // the leader's /clock is the pace
-  pacing_ = WallClockPacing(real_time_factor);
+  pacing_ = WallClockPacing(pacing_factor(parameters_.fast, parameters_.real_time_factor, parameters_.follow_clock));
 
   try {
     commands_.emplace(*simulation_, parameters_, start_time);
@@ -133,7 +116,7 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   // moved roscpp's own subscription away: see InstantPublisher).
   if (!parameters_.publish_clock && ros::Time::isSimTime()) {
     ros::NodeHandle clock_node(node_, "", ros::M_string{{"/clock", "/clock"}});
-    clock_subscriber_ = clock_node.subscribe("/clock", 1, &hear_clock);
+    clock_subscriber_ = clock_node.subscribe("/clock", 1, &CartSimNode::hear_clock, this);
   }
   commands_->subscribe(node_, [this](const std::string& topic, double time, const std_msgs::Float64& message) {
     record_command(topic, time, message);
@@ -152,16 +135,17 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
         if (!paused_) return "the run is not paused (call ~pause with data: true first)";
         return "";
       },
-      [this] { callback_queue_.wake(); });
+      [this] { callback_queue_.wake(); }, start_time);
 
   settings_.emplace(private_node_, parameters_, accuracy_guard_, *commands_, *simulation_);
 
   reports_.emplace(RunView{parameters_, *simulation_, accuracy_guard_, work_, *commands_, record_, odometry_sensor_,
-                           paused_, step_failure_, lockstep_timeouts_, end_time_},
+                           paused_, step_failure_, lockstep_timeouts_, *timeline_},
                    node_, private_node_);
 
   paused_ = parameters_.start_paused;
-  restart_schedule();
+  if (parameters_.follow_clock) start_catch_up_ = kLongestCatchUp;
+  restart_schedule(RunStart::kWhole);
   const std::string step_control = simulation_->scene().integrator.step_control == StepControl::kReversible
                                        ? " (reversible step control for " +
                                              format_seconds(simulation_->scene().integrator.position_tolerance) +
@@ -171,7 +155,7 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
            "%s, %s%s%s",
            simulation_->scene().name.c_str(), parameters_.scene_path.c_str(), simulation_->integrator_name().c_str(),
            simulation_->step_size(), step_control.c_str(), parameters_.fast ? "fast" : "real-time", parameters_.lockstep ? ", lockstep" : "",
-           parameters_.publish_rate, format_seconds(end_time_).c_str(), parameters_.frames.odom.c_str(),
+           parameters_.publish_rate, format_seconds(timeline_->end_time()).c_str(), parameters_.frames.odom.c_str(),
            parameters_.frames.base_link.c_str(),
            parameters_.publish_clock ? "publishing /clock"
                                      : (parameters_.follow_clock ? "following /clock" : "not publishing /clock"),
@@ -180,22 +164,101 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
 
 CartSimNode::~CartSimNode() = default;
 
-void CartSimNode::restart_schedule() {
-  // From the current time to the run's end: the whole run after construction or ~reset, the rest of
-  // it after a teleport (~set_state, /initialpose).
+// ---- The one restart of the run ----------------------------------------------------------------
+
+bool CartSimNode::restart_run(const std::string& source, RunStart start, const std::function<void()>& move,
+                              std::string& message) {
+  try {
+    move();
+  } catch (const std::invalid_argument& error) {
+    message = source + " refused: " + error.what() + "; the simulation goes on unchanged";
+    ROS_ERROR("cart_sim: %s", message.c_str());
+    return false;
+  }
+  accuracy_guard_.reset();
+  ++restarts_;  // a batch in progress stops: its publish instants belonged to the old start
+  const double time = simulation_->state().time;
+  commands_->restart(time);
+  if (start == RunStart::kWhole) timeline_->start_at(time);
+  restart_schedule(start);
+  step_requests_->cancel(source, time);
+  return true;
+}
+
+void CartSimNode::restart_schedule(RunStart start) {
+  // From the current time: the whole run (construction, ~reset, a follower's start on its leader's
+  // clock), or the rest of it up to the end in force (a teleport).
   const double start_time = simulation_->state().time;
-  const bool whole_run = start_time == loaded_start_time_;
-  simulation_->plan_run(whole_run || !std::isfinite(end_time_) ? run_duration_ : end_time_ - start_time);
-  // The odometry starts again at the true pose; after ~reset its noise runs again from the seed.
+  const bool whole_run = start == RunStart::kWhole;
+  simulation_->plan_run(timeline_->length_from(start_time, whole_run));
+  // The odometry starts again at the true pose; after a whole run's start its noise runs again from the seed.
   if (odometry_sensor_) odometry_sensor_->start(simulation_->state(), whole_run);
   next_publish_index_ = 1;
   next_diagnostic_index_ = 1;
   clock_started_ = false;
   publisher_->restart();
-  pacing_.restart(WallClockPacing::Clock::now(), start_time);
+  pacing_.restart(Clock::now(), start_time);
 }
 
+void CartSimNode::reset_run(const std::string& source, double catch_up) {
+  std::string refusal;
+  if (!restart_run(source, RunStart::kWhole, [this] { simulation_->reset(); }, refusal)) return;
+  // Each run gets its own bag: one bag across a reset would hold overlapping times of two runs,
+  // which playback interleaves.
+  if (record_) record_->next_run();
+  // A follower's run starts on its leader's clock, not in its past (start_on_leader_clock_if_behind).
+  if (parameters_.follow_clock) start_catch_up_ = catch_up;
+  const double start_time = simulation_->state().time;
+  ROS_INFO("cart_sim: reset to the scene's initial state at t = %.6g s%s%s%s", start_time,
+           parameters_.follow_clock ? " (then onto the leader's clock)" : "",
+           record_ && !record_->failure() ? ", recording to " : "",
+           record_ && !record_->failure() ? record_->bag().path().c_str() : "");
+}
+
+bool CartSimNode::on_reset(std_srvs::Empty::Request& /*request*/, std_srvs::Empty::Response& /*response*/) {
+  // A follower's new stamps go on from those it sent (no tf stamp twice): onto the leader's clock.
+  reset_run("~reset", 0.0);
+  return true;
+}
+
+bool CartSimNode::on_pause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response) {
+  paused_ = request.data;
+  const double time = simulation_->state().time;
+  // Scene time stands still, or goes on, from now: the real-time deadlines start here (after a
+  // ~step run while paused the last anchor lies far behind the scene time).
+  pacing_.restart(Clock::now(), time);
+  step_requests_->cancel(request.data ? "~pause" : "~pause false (the run goes on)", time);
+  response.success = true;
+  response.message = std::string(paused_ ? "paused" : "running") + " at t = " + format_seconds(time) + " s";
+  ROS_INFO("cart_sim: %s", response.message.c_str());
+  return true;
+}
+
+bool CartSimNode::teleport(const CartState& target, const std::string& source, std::string& message) {
+  if (simulation_->at_end()) {
+    message = source + " refused: the run has ended at t = " + format_seconds(simulation_->state().time) + " s";
+    ROS_ERROR("cart_sim: %s", message.c_str());
+    return false;
+  }
+  if (!restart_run(source, RunStart::kRest, [&] { simulation_->restart_from(target); }, message)) return false;
+  const Eigen::Vector2d base = simulation_->model().rear_axle_midpoint(target);
+  std::ostringstream text;
+  text << source << ": teleported at t = " << format_seconds(simulation_->state().time) << " s to base_link ("
+       << base.x() << ", " << base.y() << ") m, heading " << target.heading << " rad, steering angle "
+       << target.steering_angle << " rad, forward speed " << target.forward_speed << " m/s, steering rate "
+       << target.steering_rate << " rad/s (a restart of the run from there" << (record_ ? "; the bag goes on)" : ")");
+  message = text.str();
+  ROS_INFO("cart_sim: %s", message.c_str());
+  return true;
+}
+
+// ---- The time loop -----------------------------------------------------------------------------
+
 bool CartSimNode::stop_requested() const { return stop_flag_ || shutdown_signal_received() || !ros::ok(); }
+
+bool CartSimNode::batch_interrupted(std::uint64_t restarts_before) const {
+  return halted() || record_failed() || stop_requested() || restarts_ != restarts_before || leader_clock_went_back_;
+}
 
 bool CartSimNode::take_step() {
   commands_->apply_watchdogs();
@@ -221,16 +284,37 @@ bool CartSimNode::take_step() {
   return true;
 }
 
+void CartSimNode::publish_instant() {
+  const double wall_time_per_step = work_.end_period();  // [s]
+  const OdometryEstimate* estimate = odometry_sensor_ ? &odometry_sensor_->read(simulation_->state()) : nullptr;
+  // The accuracy guard is judged here, once per instant, before the messages are filled from it.
+  const Diagnostics diagnostics = simulation_->diagnostics();
+  accuracy_guard_.check(simulation_->state().time, diagnostics, simulation_->statistics());
+  publisher_->publish(*simulation_, diagnostics, accuracy_guard_, wall_time_per_step, estimate,
+                      record_ ? &*record_ : nullptr);
+  if (pass_due_instants(simulation_->scene().initial_state.time, parameters_.diagnostic_period, simulation_->state().time,
+                        0.5 * simulation_->step_size(), next_diagnostic_index_)) {
+    reports_->publish_diagnostics();
+  }
+}
+
 int CartSimNode::run_loop(std::string& outcome) {
-  using Clock = WallClockPacing::Clock;
   while (true) {
-    // The run's start: the scene's t0, or the time of the last teleport (~set_state, /initialpose).
+    // The run's start: the scene's t0, or the time of the last restart (a teleport, a follower's start).
     const double start = simulation_->scene().initial_state.time;
     if (stop_requested()) {
       outcome = "interrupted (shutdown requested)";
       break;
     }
     if (record_failed()) break;  // a command could not be recorded (set in a callback, also while paused)
+    if (leader_clock_went_back_) {  // the leader was reset: so is this cart, onto the leader's new clock
+      leader_clock_went_back_ = false;
+      ROS_INFO("cart_sim: the leader's /clock went back from t = %s s to t = %s s (the leader was reset); this cart "
+               "starts its scene again on the new clock",
+               format_seconds(leader_clock_before_).c_str(), format_seconds(ros::Time::now().toSec()).c_str());
+      reset_run("the leader's /clock going back", kLongestCatchUp);
+      continue;
+    }
     if (halted()) {
       wait_while_paused();
       continue;
@@ -242,9 +326,11 @@ int CartSimNode::run_loop(std::string& outcome) {
     const double instant = start + static_cast<double>(next_publish_index_) * publish_period_;
     const double half_step = 0.5 * simulation_->step_size();
     if (parameters_.follow_clock) {  // the batch runs once the leader's /clock has reached its end
-      const std::uint64_t resets_before = resets_;
-      wait_for_clock(std::min(instant, end_time_));
-      if (halted() || record_failed() || stop_requested() || resets_ != resets_before) continue;
+      if (start_catch_up_ && start_on_leader_clock_if_behind()) continue;
+      if (start_catch_up_) continue;  // no /clock heard yet
+      const std::uint64_t restarts_before = restarts_;
+      wait_for_clock(std::min(instant, timeline_->end_time()));
+      if (batch_interrupted(restarts_before)) continue;
     }
     Clock::time_point batch_start = Clock::now();
     bool failed = false;
@@ -268,17 +354,17 @@ int CartSimNode::run_loop(std::string& outcome) {
       }
       const bool step_due = !paced || due_scene_time >= next_time - half_step;
       if ((!step_due || !paced) && !parameters_.lockstep && callback_queue_.pending()) {
-        const std::uint64_t resets_before = resets_;
+        const std::uint64_t restarts_before = restarts_;
         process_callbacks();
-        if (halted() || record_failed() || stop_requested() || resets_ != resets_before) {
-          interrupted = true;  // paused, failed, stopping, reset or teleported: a new batch
+        if (batch_interrupted(restarts_before)) {
+          interrupted = true;  // paused, failed, stopping, restarted or the leader reset: a new batch
           break;
         }
         if (!step_due) continue;
       }
       if (!step_due) {
         work_.add_stepping(std::chrono::duration<double>(Clock::now() - batch_start).count());
-        wait_until_due(std::min(instant, end_time_));
+        wait_until_due(std::min(instant, timeline_->end_time()));
         batch_start = Clock::now();
         if (halted() || record_failed() || stop_requested()) {
           interrupted = true;
@@ -322,7 +408,7 @@ int CartSimNode::run() {
     // closed, exit 4; never std::terminate with the record left unfinished.
     internal_error = error.what();
   }
-  step_requests_->end(simulation_->state().time);
+  step_requests_->end(simulation_->state().time, stop_requested());
 
   if (!internal_error && !step_failure_ && !record_failed() && !stop_requested() &&
       (publisher_->listened() || reports_->diagnostics_listened())) {
@@ -363,5 +449,136 @@ void CartSimNode::record_command(const std::string& topic, double time, const st
 }
 
 bool CartSimNode::record_failed() const { return record_ && record_->failure(); }
+
+
+// ---- Pacing ------------------------------------------------------------------------------------
+
+void CartSimNode::process_callbacks() { callback_queue_.call_pending(); }
+
+bool CartSimNode::wait_until_due(double time) {
+  // The deadline is computed from the anchor on every wake: a reset or pause in a callback moves
+  // the anchor, and the next wait follows it.
+  while (!stop_requested()) {
+    const Clock::time_point deadline = std::min(pacing_.due(time), after(kLongestSleep));
+    if (callback_queue_.wait_until(deadline)) {
+      return false;  // a message: the caller runs the steps due by now, then the callbacks
+    }
+    if (Clock::now() >= pacing_.due(time)) return true;
+  }
+  return false;
+}
+
+void CartSimNode::wait_while_paused() {
+  const Clock::time_point start = Clock::now();
+  callback_queue_.wait_until(after(kLongestSleep));
+  process_callbacks();
+  work_.add_paused(std::chrono::duration<double>(Clock::now() - start).count());
+  // Scene time stood still: the next deadline starts from now.
+  pacing_.restart(Clock::now(), simulation_->state().time);
+}
+
+void CartSimNode::wait_for_controllers() {
+  const auto connected = [this] {
+    return commands_->controllers_connected() && publisher_->joint_state_subscribers() > 0;
+  };
+  // A note every ~lockstep_timeout, at most one a second (a tiny timeout would flood the log).
+  const double note_interval = std::max(parameters_.lockstep_timeout, 1.0);  // [s of wall time]
+  Clock::time_point next_note = after(note_interval);
+  while (!connected() && !stop_requested()) {
+    callback_queue_.wait_until(after(0.01));
+    process_callbacks();
+    if (Clock::now() >= next_note) {
+      ROS_WARN("cart_sim: lockstep: waiting for a controller (publishers on %s and a joint_states subscriber)",
+               commands_->expected_topics().c_str());
+      next_note = after(note_interval);
+    }
+  }
+}
+
+void CartSimNode::wait_for_commands(double time) {
+  const Clock::time_point give_up = after(parameters_.lockstep_timeout);
+  const auto answered = [this] { return commands_->answered(); };
+  // Callbacks run only here in lockstep: everything queued since the last barrier (the answers,
+  // ~pause, ~reset) takes effect at this instant.
+  process_callbacks();
+  while (!answered() && !stop_requested() && !paused_) {
+    const Clock::time_point now = Clock::now();
+    if (now >= give_up) {
+      ++lockstep_timeouts_;
+      // Counted each time; said at most once a second (a tiny ~lockstep_timeout would flood the log).
+      ROS_WARN_THROTTLE(1.0, "cart_sim: lockstep: no answer on %s within %g s of wall time after t = %.6g s; going on "
+               "(%lu timeouts so far)",
+               commands_->unanswered_topics().c_str(), parameters_.lockstep_timeout, time,
+               static_cast<unsigned long>(lockstep_timeouts_));
+      break;
+    }
+    // A controller in the same process (a nodelet) answers within microseconds: poll for it a
+    // little before sleeping, since a sleep and its wake-up cost more than the answer takes.
+    const Clock::time_point spin_until = now + std::chrono::microseconds(kLockstepSpinMicroseconds);
+    while (!callback_queue_.pending() && Clock::now() < spin_until) std::this_thread::yield();
+    callback_queue_.wait_until(std::min(give_up, now + std::chrono::duration_cast<Clock::duration>(
+                                                           std::chrono::duration<double>(kLongestSleep))));
+    process_callbacks();
+  }
+  // The answers are recorded at the instant they answer, in the order of their topics' names.
+  commands_->end_barrier(time);
+  // The wait is the controllers' time, not the simulator's: real-time pacing starts again here.
+  if (pacing_.paced()) pacing_.restart(Clock::now(), simulation_->state().time);
+}
+
+void CartSimNode::wait_for_clock(double time) {
+  // ros::Time::now() is the /clock of the node that drives it (hear_clock). 1 µs allows for the
+  // nanosecond rounding of ROS time. A restart served while waiting ends the wait (`time` belongs
+  // to the run before it), and so does the leader's clock going back (its reset).
+  constexpr double kStampRounding = 1e-6;  // [s]
+  const std::uint64_t restarts_before = restarts_;
+  while (ros::Time::now().toSec() < time - kStampRounding && !batch_interrupted(restarts_before)) {
+    callback_queue_.wait_until(after(kClockPoll));
+    process_callbacks();
+  }
+}
+
+bool CartSimNode::start_on_leader_clock_if_behind() {
+  if (ros::Time::now().isZero()) {  // no /clock heard yet: wait for the leader's first
+    callback_queue_.wait_until(after(kClockPoll));
+    process_callbacks();
+    return false;
+  }
+  const double catch_up = *start_catch_up_;
+  start_catch_up_.reset();
+  const double leader_time = ros::Time::now().toSec();
+  const double start = start_on_leader_clock(simulation_->state().time, leader_time, publish_period_, catch_up);
+  if (!(start > simulation_->state().time)) return false;  // the leader has not passed this run's first instant
+  // The whole run, moved: its end and the ROS-time rules checked before anything changes.
+  RunTimeline moved = *timeline_;
+  std::string refusal;
+  try {
+    moved.start_at(start);
+  } catch (const RunTimelineError& error) {
+    refusal = error.what();
+  }
+  CartState target = simulation_->state();
+  target.time = start;
+  if (refusal.empty() &&
+      restart_run("the start on the leader's clock", RunStart::kWhole, [&] { simulation_->restart_from(target); },
+                  refusal)) {
+    ROS_INFO("cart_sim: the leader's /clock is at t = %s s: this cart's run starts on it, at t = %s s (not in "
+             "the leader's past, which it would replay in a burst)",
+             format_seconds(leader_time).c_str(), format_seconds(start).c_str());
+    return true;
+  }
+  ROS_WARN("cart_sim: cannot start on the leader's clock at t = %s s (%s); this cart steps from t = %s s up to it",
+           format_seconds(start).c_str(), refusal.c_str(), format_seconds(simulation_->state().time).c_str());
+  return false;
+}
+
+void CartSimNode::hear_clock(const rosgraph_msgs::Clock::ConstPtr& clock) {
+  const ros::Time before = ros::Time::now();
+  if (parameters_.follow_clock && clock->clock < before) {
+    leader_clock_went_back_ = true;
+    leader_clock_before_ = before.toSec();
+  }
+  ros::Time::setNow(clock->clock);  // what roscpp's own /clock subscription does
+}
 
 }  // namespace birkhoff_cart

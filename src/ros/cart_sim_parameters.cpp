@@ -12,15 +12,30 @@
 namespace birkhoff_cart {
 namespace {
 
+/// What a parameter of type T must be, for a refusal.
+template <class T>
+const char* expected_type();
+template <>
+const char* expected_type<bool>() { return "a bool (true or false)"; }
+template <>
+const char* expected_type<std::string>() { return "a string"; }
+template <>
+const char* expected_type<std::vector<std::string>>() { return "a list of strings"; }
+
 template <class T>
 T read_parameter(const ros::NodeHandle& node, const std::string& name, const T& fallback) {
   T value;
   if (node.getParam(name, value)) return value;
   if (node.hasParam(name)) {
-    throw std::invalid_argument("parameter " + node.resolveName(name) + " has the wrong type");
+    throw std::invalid_argument("parameter " + node.resolveName(name) + " must be " + expected_type<T>() + ", got " +
+                                describe_parameter_value(node, name));
   }
   return fallback;
 }
+
+/// The most publish (or diagnostic) instants per second of scene time [Hz]: the instant index k
+/// stays exact in a double (2^53) over the 2^32 s of ROS time.
+constexpr double kHighestInstantRate = 1e6;
 
 void require(bool condition, const std::string& message) {
   if (!condition) throw std::invalid_argument(message);
@@ -62,7 +77,7 @@ const std::vector<std::string>& cart_sim_parameter_names() {
       "scene", "integrator", "step_size", "publish_rate", "fast", "real_time_factor", "duration", "command_timeout",
       "max_steering_torque", "max_drive_torque", "lockstep", "lockstep_topics", "lockstep_timeout", "bag_path",
       "record_wall_time", "bag_compression", "min_free_disk_space", "summary_path", "frame_prefix", "odom_frame",
-      "base_frame", "world_frame", "publish_world_tf", "pose_covariance_diagonal", "twist_covariance_diagonal", "publish_tf", "publish_clock",
+      "base_frame", "world_frame", "ground_truth_frame", "publish_world_tf", "pose_covariance_diagonal", "twist_covariance_diagonal", "publish_tf", "publish_clock",
       "follow_clock", "start_paused", "diagnostic_period", "energy_residual_warn", "energy_residual_error",
       "p2_residual_warn", "p2_residual_error", "constraint_residual_warn", "constraint_residual_error", "end_launch",
       "accuracy/",
@@ -83,7 +98,10 @@ CartSimParameters load_parameters(const ros::NodeHandle& private_node) {
   require(std::isfinite(parameters.step_size) && parameters.step_size >= 0.0,
           "~step_size must be >= 0 s (0 = the scene's)");
   parameters.publish_rate = read_double_parameter(p, "publish_rate", parameters.publish_rate);
-  require(std::isfinite(parameters.publish_rate) && parameters.publish_rate > 0.0, "~publish_rate must be > 0 Hz");
+  // An instant's index k (t0 + k/rate) stays exact in a double over ROS time's 2^32 s up to 2^21 Hz.
+  require(std::isfinite(parameters.publish_rate) && parameters.publish_rate > 0.0 &&
+              parameters.publish_rate <= kHighestInstantRate,
+          "~publish_rate must be > 0 and <= 1e6 Hz, got " + format_seconds(parameters.publish_rate));
   parameters.fast = read_parameter<bool>(p, "fast", parameters.fast);
   parameters.real_time_factor = read_double_parameter(p, "real_time_factor", parameters.real_time_factor);
   require(std::isfinite(parameters.real_time_factor) && parameters.real_time_factor >= 0.0,
@@ -123,12 +141,17 @@ CartSimParameters load_parameters(const ros::NodeHandle& private_node) {
   parameters.frame_prefix = read_parameter<std::string>(p, "frame_prefix", parameters.frame_prefix);
   parameters.frames = ros_conversions::prefixed_frames(
       parameters.frame_prefix, read_parameter<std::string>(p, "odom_frame", parameters.frames.odom),
-      read_parameter<std::string>(p, "base_frame", parameters.frames.base_link));
+      read_parameter<std::string>(p, "base_frame", parameters.frames.base_link),
+      read_parameter<std::string>(p, "ground_truth_frame", parameters.frames.ground_truth));
   require(parameters.frames.odom != parameters.frames.base_link, "~odom_frame and ~base_frame must differ");
+  require(parameters.frames.ground_truth != parameters.frames.odom &&
+              parameters.frames.ground_truth != parameters.frames.base_link,
+          "~ground_truth_frame must differ from the odom and base frames (one frame pair, one source)");
   parameters.frames.world = read_parameter<std::string>(p, "world_frame", parameters.frames.world);
   require(!parameters.frames.world.empty() && parameters.frames.world != parameters.frames.odom &&
-              parameters.frames.world != parameters.frames.base_link,
-          "~world_frame must be a frame name other than the odom and base frames");
+              parameters.frames.world != parameters.frames.base_link &&
+              parameters.frames.world != parameters.frames.ground_truth,
+          "~world_frame must be a frame name other than the odom, base and ground truth frames");
   parameters.publish_world_tf = read_parameter<bool>(p, "publish_world_tf", parameters.publish_world_tf);
   parameters.odometry_covariance.pose_diagonal =
       read_variances(p, "pose_covariance_diagonal", parameters.odometry_covariance.pose_diagonal);
@@ -141,8 +164,8 @@ CartSimParameters load_parameters(const ros::NodeHandle& private_node) {
           "~follow_clock needs ~publish_clock false: a node cannot follow the clock it drives itself");
   parameters.start_paused = read_parameter<bool>(p, "start_paused", parameters.start_paused);
   parameters.diagnostic_period = read_double_parameter(p, "diagnostic_period", parameters.diagnostic_period);
-  require(std::isfinite(parameters.diagnostic_period) && parameters.diagnostic_period > 0.0,
-          "~diagnostic_period must be > 0 s");
+  require(std::isfinite(parameters.diagnostic_period) && parameters.diagnostic_period >= 1.0 / kHighestInstantRate,
+          "~diagnostic_period must be >= 1e-6 s, got " + format_seconds(parameters.diagnostic_period));
   return parameters;
 }
 }  // namespace birkhoff_cart

@@ -113,9 +113,10 @@ void CartSimReports::report_progress() {
   if (!real_time_factor) return;
   const double time = run_.simulation.state().time;
   const double start_time = run_.simulation.scene().initial_state.time;
-  if (std::isfinite(run_.end_time)) {
-    ROS_INFO("cart_sim: t = %.3f s of %.3f s (%.1f %%), real-time factor %.1f", time, run_.end_time,
-             100.0 * (time - start_time) / (run_.end_time - start_time), *real_time_factor);
+  const double end_time = run_.timeline.end_time();
+  if (std::isfinite(end_time)) {
+    ROS_INFO("cart_sim: t = %.3f s of %.3f s (%.1f %%), real-time factor %.1f", time, end_time,
+             100.0 * (time - start_time) / (end_time - start_time), *real_time_factor);
   } else {
     ROS_INFO("cart_sim: t = %.3f s (until shutdown), real-time factor %.1f", time, *real_time_factor);
   }

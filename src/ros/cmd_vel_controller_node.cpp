@@ -19,7 +19,8 @@ bool read_switch(const ros::NodeHandle& node, const std::string& name) {
   XmlRpc::XmlRpcValue value;
   if (!node.getParam(name, value)) return true;
   if (value.getType() != XmlRpc::XmlRpcValue::TypeBoolean) {
-    throw std::invalid_argument("parameter " + node.resolveName(name) + " must be true or false");
+    throw std::invalid_argument("parameter " + node.resolveName(name) + " must be a bool (true or false), got " +
+                                describe_parameter_value(node, name));
   }
   return static_cast<bool>(value);
 }
@@ -180,8 +181,10 @@ void CmdVelControllerNode::on_reconfigure(CmdVelControllerConfig& config, std::u
              "cmd_vel_timeout %g s", settings.min_velocity, settings.max_velocity, settings.max_yaw_rate,
              settings.steering_p, settings.steering_d, settings.drive_p, settings.drive_i, settings.cmd_vel_timeout);
   } catch (const std::invalid_argument& error) {
-    ROS_ERROR("cmd_vel_controller: reconfiguration refused (the running settings stay): %s", error.what());
-    config = to_config(controller_.settings());  // dynamic_reconfigure reports the settings in force
+    // The set answers with the settings in force (dynamic_reconfigure returns `config`), and the
+    // line names the value typed (the cfg does not clamp: the node sees what was typed).
+    ROS_WARN("cmd_vel_controller: dynamic_reconfigure set refused, the running settings stay: %s", error.what());
+    config = to_config(controller_.settings());
   }
 }
 

@@ -48,10 +48,12 @@ ros::Time to_ros_time(double time) {
   return ros::Time(time);
 }
 
-FrameNames prefixed_frames(const std::string& prefix, const std::string& odom, const std::string& base_link) {
+FrameNames prefixed_frames(const std::string& prefix, const std::string& odom, const std::string& base_link,
+                           const std::string& ground_truth) {
   FrameNames frames;
   frames.odom = prefix + odom;
   frames.base_link = prefix + base_link;
+  frames.ground_truth = prefix + ground_truth;
   frames.joint_prefix = prefix;
   return frames;
 }

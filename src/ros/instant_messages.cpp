@@ -34,6 +34,7 @@ InstantMessages::InstantMessages(ros_conversions::FrameNames frames, ros_convers
     : frames_(std::move(frames)), covariance_(covariance) {
   ground_truth_frames_ = frames_;
   ground_truth_frames_.odom = frames_.world;
+  ground_truth_frames_.base_link = frames_.ground_truth;
   transforms.transforms.resize(1);
   // What an instant never changes in the ground truth (the frames, the exact state's covariances 0).
   ground_truth.header.frame_id = ground_truth_frames_.odom;

@@ -1,6 +1,7 @@
 // The package's one reader of numeric parameters (see parameter_reading.h).
 #include "birkhoff_cart/ros/parameter_reading.h"
 
+#include <sstream>
 #include <stdexcept>
 
 #include <ros/param.h>
@@ -25,7 +26,26 @@ double read_double_parameter(const ros::NodeHandle& node, const std::string& nam
     } catch (const std::exception&) {
     }
   }
-  throw std::invalid_argument("parameter " + node.resolveName(name) + " must be a number");
+  throw std::invalid_argument("parameter " + node.resolveName(name) + " must be a number, got " +
+                              describe_parameter_value(node, name));
+}
+
+std::string describe_parameter_value(const ros::NodeHandle& node, const std::string& name) {
+  XmlRpc::XmlRpcValue value;
+  if (!node.getParam(name, value)) return "nothing";
+  switch (value.getType()) {
+    case XmlRpc::XmlRpcValue::TypeBoolean: return std::string("the bool ") + (static_cast<bool>(value) ? "true" : "false");
+    case XmlRpc::XmlRpcValue::TypeInt: return "the int " + std::to_string(static_cast<int>(value));
+    case XmlRpc::XmlRpcValue::TypeDouble: {
+      std::ostringstream text;
+      text << "the double " << static_cast<double>(value);
+      return text.str();
+    }
+    case XmlRpc::XmlRpcValue::TypeString: return "the string '" + static_cast<std::string>(value) + "'";
+    case XmlRpc::XmlRpcValue::TypeArray: return "a list of " + std::to_string(value.size()) + " values";
+    case XmlRpc::XmlRpcValue::TypeStruct: return "a dictionary";
+    default: return "a value of another type";
+  }
 }
 
 std::vector<std::string> unknown_private_parameters(const ros::NodeHandle& private_node,

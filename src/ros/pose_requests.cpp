@@ -5,7 +5,9 @@
 #include <sstream>
 #include <utility>
 
+#include <tf2/exceptions.h>
 #include <tf2/utils.h>
+#include <tf2_geometry_msgs/tf2_geometry_msgs.h>
 
 namespace birkhoff_cart {
 namespace {
@@ -27,6 +29,8 @@ PoseRequests::PoseRequests(ros::NodeHandle& node, ros::NodeHandle& private_node,
     : parameters_(parameters), simulation_(simulation), teleport_(std::move(teleport)) {
   set_state_service_ = private_node.advertiseService("set_state", &PoseRequests::on_set_state, this);
   initial_pose_subscriber_ = node.subscribe("initialpose", 5, &PoseRequests::on_initial_pose, this);
+  // Latched: every static transform published so far arrives once, then only new ones.
+  static_transform_subscriber_ = node.subscribe("/tf_static", 100, &PoseRequests::on_static_transforms, this);
 }
 
 bool PoseRequests::on_set_state(SetCartState::Request& request, SetCartState::Response& response) {
@@ -53,41 +57,71 @@ bool PoseRequests::on_set_state(SetCartState::Request& request, SetCartState::Re
   return true;
 }
 
+void PoseRequests::on_static_transforms(const tf2_msgs::TFMessage::ConstPtr& message) {
+  for (const geometry_msgs::TransformStamped& transform : message->transforms) {
+    static_frames_.setTransform(transform, "/tf_static", true);  // a malformed one is logged by tf2 and skipped
+  }
+}
+
+void PoseRequests::refuse_initial_pose(const std::string& why) const {
+  ROS_ERROR("cart_sim: %s refused: %s; the simulation goes on unchanged", initial_pose_subscriber_.getTopic().c_str(),
+            why.c_str());
+}
+
 void PoseRequests::on_initial_pose(const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& message) {
-  // The odom frame, or the world frame while map -> odom is cart_sim's identity (~publish_world_tf):
-  // the same coordinates. With a localizer of the user's owning map -> odom, only odom.
   const std::string& frame = message->header.frame_id;
-  const bool world_is_odom = parameters_.publish_world_tf && frame == parameters_.frames.world;
-  if (!frame.empty() && frame != parameters_.frames.odom && !world_is_odom) {
-    ROS_ERROR("cart_sim: %s refused: the pose is in frame '%s', cart_sim places the cart in '%s'%s (set rviz's "
-              "fixed frame to it); the simulation goes on unchanged",
-              initial_pose_subscriber_.getTopic().c_str(), frame.c_str(), parameters_.frames.odom.c_str(),
-              parameters_.publish_world_tf ? (" or '" + parameters_.frames.world + "'").c_str() : "");
+  const std::string& odom = parameters_.frames.odom;
+  if (frame.empty()) {
+    refuse_initial_pose("header.frame_id is empty: name the frame of the pose ('" + odom +
+                        "' or a frame /tf_static fixes to it, e.g. rviz's fixed frame)");
     return;
   }
   const geometry_msgs::Pose& pose = message->pose.pose;
-  const double values[] = {pose.position.x, pose.position.y, pose.orientation.x, pose.orientation.y,
-                           pose.orientation.z, pose.orientation.w};
-  for (double value : values) {
+  const std::pair<const char*, double> fields[] = {
+      {"pose.pose.position.x", pose.position.x},       {"pose.pose.position.y", pose.position.y},
+      {"pose.pose.position.z", pose.position.z},       {"pose.pose.orientation.x", pose.orientation.x},
+      {"pose.pose.orientation.y", pose.orientation.y}, {"pose.pose.orientation.z", pose.orientation.z},
+      {"pose.pose.orientation.w", pose.orientation.w}};
+  for (const auto& [name, value] : fields) {
     if (!std::isfinite(value)) {
-      ROS_ERROR("cart_sim: %s refused: a non-finite pose field (%g); the simulation goes on unchanged",
-                initial_pose_subscriber_.getTopic().c_str(), value);
+      std::ostringstream text;
+      text << name << " must be finite, got " << value;
+      refuse_initial_pose(text.str());
       return;
     }
   }
   const double norm = std::sqrt(pose.orientation.x * pose.orientation.x + pose.orientation.y * pose.orientation.y +
                                 pose.orientation.z * pose.orientation.z + pose.orientation.w * pose.orientation.w);
   if (!(norm > 1e-6)) {
-    ROS_ERROR("cart_sim: %s refused: the orientation quaternion has norm %g; the simulation goes on unchanged",
-              initial_pose_subscriber_.getTopic().c_str(), norm);
+    std::ostringstream text;
+    text << "the orientation quaternion pose.pose.orientation has norm " << norm;
+    refuse_initial_pose(text.str());
     return;
   }
-  tf2::Quaternion orientation(pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w);
+  // Into odom: directly (odom, or cart_sim's own world frame while ~publish_world_tf makes it the
+  // identity), or through the static transforms from the pose's frame (a world above cart_sim's,
+  // from a static_transform_publisher).
+  geometry_msgs::Pose in_odom = pose;
+  const bool world_is_odom = parameters_.publish_world_tf && frame == parameters_.frames.world;
+  if (frame != odom && !world_is_odom) {
+    try {
+      const geometry_msgs::TransformStamped transform = static_frames_.lookupTransform(odom, frame, ros::Time(0));
+      tf2::doTransform(pose, in_odom, transform);
+    } catch (const tf2::TransformException& error) {
+      refuse_initial_pose("the pose is in frame '" + frame + "', which /tf_static does not fix to '" + odom +
+                          "' (cart_sim places the cart in '" + odom + "' or a frame fixed to it on /tf_static" +
+                          (parameters_.publish_world_tf ? ", such as '" + parameters_.frames.world + "'" : "") +
+                          "; set rviz's fixed frame to one): " + error.what());
+      return;
+    }
+  }
+  tf2::Quaternion orientation(in_odom.orientation.x, in_odom.orientation.y, in_odom.orientation.z,
+                              in_odom.orientation.w);
   orientation.normalize();
   // Like rviz's 2D Pose Estimate on a robot at rest: the pose is set, the cart stands still, the
   // steering angle stays.
   CartState target = simulation_.state();
-  place_hinge(target, pose.position.x, pose.position.y, tf2::getYaw(orientation),
+  place_hinge(target, in_odom.position.x, in_odom.position.y, tf2::getYaw(orientation),
               simulation_.model().parameters().wheelbase);
   target.forward_speed = 0.0;
   target.steering_rate = 0.0;

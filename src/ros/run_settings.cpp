@@ -64,8 +64,10 @@ void RunSettings::on_reconfigure(CartSimConfig& config, std::uint32_t /*level*/)
              format_seconds(simulation_.state().time).c_str(), config.max_steering_torque, config.max_drive_torque,
              config.command_timeout);
   } catch (const std::invalid_argument& error) {
-    ROS_ERROR("cart_sim: reconfiguration refused (the running settings stay): %s", error.what());
-    config = in_force();  // dynamic_reconfigure reports the settings in force
+    // The set answers with the settings in force (dynamic_reconfigure returns `config`), and the
+    // line names the value typed (the cfg does not clamp: the node sees what was typed).
+    ROS_WARN("cart_sim: dynamic_reconfigure set refused, the running settings stay: %s", error.what());
+    config = in_force();
   }
 }
 

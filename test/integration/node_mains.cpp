@@ -3,6 +3,7 @@
 // namespace or remapping roscpp refuses; every node let it escape main (std::terminate, exit 134,
 // no line of its own). steering_driver's timer threw std::runtime_error for ~rate 1e-12 Hz (a
 // period beyond ros::Duration's 2^31 s). Each must now end with exit 2 and a line naming the problem.
+// A parameter of the wrong type names the type it must have and what it got.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -50,6 +51,23 @@ TEST(SteeringDriver, RefusesARateItsTimerCannotHold) {
     EXPECT_NE(output.find("~rate must be in"), std::string::npos) << output;
     EXPECT_EQ(output.find("terminate called"), std::string::npos) << output;
     ros::NodeHandle().deleteParam("/driver_rate");
+  }
+}
+
+TEST(CartSim, NamesTheTypeAParameterMustHave) {
+  // Regression: `_fast:=1` (an int) said only "has the wrong type".
+  const std::string scene = std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/default.yaml";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"_fast:=1", "parameter /typed_sim/fast must be a bool (true or false), got the int 1"},
+      {"_lockstep:=yes", "parameter /typed_sim/lockstep must be a bool (true or false), got the string 'yes'"},
+      {"_integrator:=4", "parameter /typed_sim/integrator must be a string, got the int 4"},
+      {"_publish_rate:=fast", "parameter /typed_sim/publish_rate must be a number, got the string 'fast'"}};
+  for (const auto& [argument, expected] : cases) {
+    std::string output;
+    const int status = run_node("cart_sim", "__name:=typed_sim _scene:=" + scene + " " + argument, &output);
+    EXPECT_EQ(status, 2) << argument << ":\n" << output;
+    EXPECT_NE(output.find(expected), std::string::npos) << argument << ":\n" << output;
+    ros::NodeHandle().deleteParam("/typed_sim");
   }
 }
 

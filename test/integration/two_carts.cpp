@@ -3,8 +3,8 @@
 // odom, joint_states and the tf tree (cartN/odom → cartN/base_link from cart_sim, the links from its
 // robot_state_publisher) carry its own prefix, and its odometry agrees with a core Simulation of its
 // own scene at every stamp; the two trees share no frame; /clock has one publisher and never goes
-// back. Reset both (the clock source first): the follower's new run starts on the leader's new
-// clock at once.
+// back. The follower reset alone starts its scene again at the leader's current time (no stamp sent
+// twice); reset with the leader (either first), its new run starts on the leader's new clock at once.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -32,7 +32,7 @@ constexpr double kStampTolerance = 1e-9;     // [s]
 constexpr double kWaitTimeout = 60.0;        // [s of wall time], only against hangs
 constexpr double kDuration = 2.0;            // the span checked, from both carts' start [s]
 constexpr double kPublishRate = 50.0;        // both carts' ~publish_rate [Hz]
-constexpr double kResetAfter = 8.0;          // scene time cart2 reaches before both carts are reset [s]
+constexpr double kResetAfter = 8.0;          // scene time cart2 reaches before it is reset alone [s]
 
 /// What one cart publishes, collected by topic.
 struct CartRecord {
@@ -144,32 +144,65 @@ TEST(TwoCarts, EachCartHasItsOwnTreeAndOdometryUnderOneClock) {
   EXPECT_GT(std::abs(cart2.odometry[expected - 1].pose.pose.position.x - cart2.odometry.front().pose.pose.position.x),
             1.0);
 
-  // Resetting both carts, the clock source first: the follower starts its new run at once, on the
-  // leader's new clock, instead of waiting (silent) until /clock has passed its pre-reset time.
+  // The follower alone reset: its scene starts again at the leader's current time, on
+  // its publish grid, and goes on from there. Before, it replayed the leader's past in a burst
+  // (stamps from t0 again: TF_REPEATED_DATA in every tf listener).
   ASSERT_TRUE(birkhoff_cart_test::wait_for(
       [&] { return cart2.odometry.back().header.stamp.toSec() >= kResetAfter; }, kWaitTimeout));
-  const double before_reset = cart2.odometry.back().header.stamp.toSec();  // [s]
-  const std::size_t clocks_before_reset = clocks.size();
   std_srvs::Empty reset;
-  ASSERT_TRUE(ros::service::call("/cart1/cart_sim/reset", reset));
+  const std::size_t before_follower_reset = cart2.odometry.size();
   ASSERT_TRUE(ros::service::call("/cart2/cart_sim/reset", reset));
-  // /clock messages of the leader's new run that came before the follower's first new odom: a
-  // handful when the follower starts at once; about before_reset × 50 Hz when it waits for /clock
-  // to come back to its pre-reset time.
-  std::size_t new_clocks_first = 0;
   ASSERT_TRUE(birkhoff_cart_test::wait_for(
-      [&] {
-        if (cart2.odometry.back().header.stamp.toSec() >= 0.5 * before_reset) return false;
-        for (std::size_t i = clocks_before_reset; i < clocks.size(); ++i) {
-          new_clocks_first += clocks[i].toSec() < 0.5 * before_reset ? 1 : 0;
-        }
-        return true;
-      },
-      kWaitTimeout))
-      << "cart2 published nothing of its new run: " << cart2.odometry.size() << " odom, the last at "
-      << cart2.odometry.back().header.stamp.toSec() << " s; /clock at " << clocks.back().toSec() << " s";
-  EXPECT_LT(new_clocks_first, 50u) << "cart2 resumed only after " << new_clocks_first
-                                   << " /clock messages of the new run (reset at " << before_reset << " s)";
+      [&] { return cart2.odometry.size() >= before_follower_reset + expected; }, kWaitTimeout));
+  for (std::size_t i = before_follower_reset; i < before_follower_reset + expected; ++i) {
+    EXPECT_GT(cart2.odometry[i].header.stamp, cart2.odometry[i - 1].header.stamp)
+        << "cart2 sent a stamp again after its ~reset: " << cart2.odometry[i].header.stamp.toSec() << " s";
+  }
+  {
+    // The new run is the scene's run shifted to its new start (free_coast has no time-dependent load).
+    const double new_start = cart2.odometry[before_follower_reset].header.stamp.toSec() - 1.0 / kPublishRate;
+    EXPECT_GE(new_start, kResetAfter - kStampTolerance) << "cart2 started again in the leader's past";
+    birkhoff_cart::Simulation simulation(birkhoff_cart::load_scene(cart2_scene));
+    for (std::size_t i = before_follower_reset; i < before_follower_reset + expected; ++i) {
+      const nav_msgs::Odometry& odom = cart2.odometry[i];
+      SCOPED_TRACE("after cart2's reset, at t = " + std::to_string(odom.header.stamp.toSec()));
+      simulation.advance_to(simulation.scene().initial_state.time + (odom.header.stamp.toSec() - new_start));
+      const Eigen::Vector2d rear_axle_midpoint = simulation.model().rear_axle_midpoint(simulation.state());
+      EXPECT_NEAR(odom.pose.pose.position.x, rear_axle_midpoint.x(), kPositionTolerance);
+      EXPECT_NEAR(odom.pose.pose.position.y, rear_axle_midpoint.y(), kPositionTolerance);
+    }
+  }
+
+  // Then the follower and the leader reset, in either order: the follower's new run starts on the
+  // leader's new clock at once. Before, with the follower reset first, it then waited, frozen and
+  // without a log line, until the leader's clock came back to its time.
+  for (const bool leader_first : {false, true}) {
+    SCOPED_TRACE(leader_first ? "the leader reset first" : "the follower reset first");
+    const double after = cart2.odometry.back().header.stamp.toSec() + 1.0;  // [s]
+    ASSERT_TRUE(birkhoff_cart_test::wait_for(
+        [&] { return cart2.odometry.back().header.stamp.toSec() >= after; }, kWaitTimeout));
+    const double before_reset = cart2.odometry.back().header.stamp.toSec();  // [s]
+    const std::size_t clocks_before_reset = clocks.size();
+    ASSERT_TRUE(ros::service::call(leader_first ? "/cart1/cart_sim/reset" : "/cart2/cart_sim/reset", reset));
+    ASSERT_TRUE(ros::service::call(leader_first ? "/cart2/cart_sim/reset" : "/cart1/cart_sim/reset", reset));
+    // /clock messages of the leader's new run that came before the follower's first new odom: a
+    // handful when the follower starts at once; about before_reset × 50 Hz when it waits for /clock
+    // to come back to its pre-reset time.
+    std::size_t new_clocks_first = 0;
+    ASSERT_TRUE(birkhoff_cart_test::wait_for(
+        [&] {
+          if (cart2.odometry.back().header.stamp.toSec() >= 0.5 * before_reset) return false;
+          for (std::size_t i = clocks_before_reset; i < clocks.size(); ++i) {
+            new_clocks_first += clocks[i].toSec() < 0.5 * before_reset ? 1 : 0;
+          }
+          return true;
+        },
+        kWaitTimeout))
+        << "cart2 published nothing of its new run: " << cart2.odometry.size() << " odom, the last at "
+        << cart2.odometry.back().header.stamp.toSec() << " s; /clock at " << clocks.back().toSec() << " s";
+    EXPECT_LT(new_clocks_first, 50u) << "cart2 resumed only after " << new_clocks_first
+                                     << " /clock messages of the new run (reset at " << before_reset << " s)";
+  }
 }
 
 }  // namespace

@@ -74,6 +74,7 @@ TEST(Conversions, FramePrefixGoesBeforeFramesAndJoints) {
   const nav_msgs::Odometry odometry = ros_conversions::to_odometry(moving_state(), model, frames);
   EXPECT_EQ(odometry.header.frame_id, "cart2/odom");
   EXPECT_EQ(odometry.child_frame_id, "cart2/base_link");
+  EXPECT_EQ(frames.ground_truth, "cart2/base_link_ground_truth");
   const sensor_msgs::JointState joints =
       ros_conversions::to_joint_state(moving_state(), model, {}, frames.joint_prefix);
   ASSERT_EQ(joints.name.size(), 5u);

@@ -139,10 +139,12 @@ TEST(InstantMessages, FilledMessagesEqualTheConversions) {
   const CartState& state = simulation.state();
   const nav_msgs::Odometry odometry = ros_conversions::to_odometry(state, simulation.model(), prefixed());
   EXPECT_EQ(messages.odometry, odometry);
-  // The ground truth: the exact state in the world frame, covariances 0 (its pose and twist are
-  // odom's, copied rather than computed again).
+  // The ground truth: the exact state in the world frame, on its own child frame (base_link is the
+  // odometry's), covariances 0 (its pose and twist are odom's, copied rather than computed again).
   ros_conversions::FrameNames world_frames = prefixed();
   world_frames.odom = world_frames.world;
+  world_frames.base_link = world_frames.ground_truth;
+  EXPECT_EQ(messages.ground_truth.child_frame_id, std::string(kPrefix) + "base_link_ground_truth");
   const ros_conversions::OdometryCovariance exact{{0, 0, 0, 0, 0, 0}, {0, 0, 0, 0, 0, 0}};
   EXPECT_EQ(messages.ground_truth, ros_conversions::to_odometry(state, simulation.model(), world_frames, exact));
   const sensor_msgs::JointState joints = ros_conversions::to_joint_state(

@@ -177,23 +177,46 @@ TEST(AdaptiveStepControl, AStiffHingeRunsWhereFixedStepsFail) {
     fixed_failed = true;
   }
   EXPECT_TRUE(fixed_failed) << "gauss4 at h = 0.05 s ran the very stiff hinge";
+  // Every output row (100 Hz) against dopri5 at 1e-13 at the same instant: a row from a rejected
+  // attempt would be off by far more than the tolerance.
+  Scene tight = configured(scene, "dopri5", StepControl::kFixed, 1e-13);
+  tight.integrator.step_size = 0.01;
   for (const std::string member : {"birkhoff_gauss4", "birkhoff_gauss8"}) {
     Scene adaptive = configured(scene, member, StepControl::kAdaptive, 1e-6);
     adaptive.integrator.step_size = 0.01;
     Simulation simulation(adaptive);
+    Simulation lockstep_reference(tight);
     double largest = 0.0;
-    simulation.observe_grid([&](const CartState& grid) { largest = std::max(largest, std::abs(grid.x) + std::abs(grid.y)); });
+    double worst_row = 0.0;   // [m]
+    double worst_grid = 0.0;  // [m]
+    Scene tight_own_steps = tight;
+    tight_own_steps.integrator.step_size = tight.duration;
+    Simulation grid_reference(tight_own_steps);  // dopri5 at 1e-13 to each grid instant
+    simulation.observe_grid([&](const CartState& grid) {
+      largest = std::max(largest, std::abs(grid.x) + std::abs(grid.y));
+      if (grid.time > grid_reference.state().time) grid_reference.advance_output_to(grid.time);
+      if (grid.time == grid_reference.state().time) {
+        worst_grid = std::max(worst_grid, position_error(grid, grid_reference.state()));
+      }
+    });
     while (!simulation.at_end()) {
       simulation.step_on_schedule();
+      lockstep_reference.step_on_schedule();
       const CartState& out = simulation.state();
       ASSERT_TRUE(std::isfinite(out.x) && std::isfinite(out.y) && std::isfinite(out.forward_speed));
+      ASSERT_EQ(out.time, lockstep_reference.state().time);
       largest = std::max(largest, std::abs(out.x) + std::abs(out.y));
+      worst_row = std::max(worst_row, position_error(out, lockstep_reference.state()));
     }
     const double error = position_error(simulation.state(), reference);
-    std::printf("[ measured ] very_stiff_hinge %s adaptive at 1e-6 m: error %.2e m, %llu steps, %llu rejected\n",
-                member.c_str(), error, static_cast<unsigned long long>(simulation.statistics().internal_steps),
+    std::printf("[ measured ] very_stiff_hinge %s adaptive at 1e-6 m: error %.2e m (worst of %llu rows %.2e m, of the grid "
+                "%.2e m), %llu steps, %llu rejected\n",
+                member.c_str(), error, static_cast<unsigned long long>(simulation.statistics().steps), worst_row, worst_grid,
+                static_cast<unsigned long long>(simulation.statistics().internal_steps),
                 static_cast<unsigned long long>(simulation.statistics().rejected_steps));
     EXPECT_LE(error, 1e-5) << member;
+    EXPECT_LE(worst_row, 1e-5) << member << ": an output row off by more than 10x the tolerance";
+    EXPECT_LE(worst_grid, 1e-6) << member << ": a grid state off by more than the tolerance";
     EXPECT_GT(simulation.statistics().rejected_steps, 0u) << member << ": the start is stiff enough to reject";
     EXPECT_LT(largest, 2.0 * (std::abs(reference.x) + std::abs(reference.y)) + 1.0) << member;
   }

@@ -5,8 +5,10 @@
 //    cart (the symmetry by reversal: registry_properties_test);
 //  - a row that claims the reversible control builds it and meets a position tolerance with it; any
 //    other is refused by name; the claim is the rule "symmetric Birkhoffian member";
+//  - a row that claims the adaptive control builds it and meets a position tolerance with it on a
+//    forced scene; any other is refused by name; the claim is the rule "Birkhoffian member or dopri5";
 //  - a row that claims a tolerance (kind adaptive) refuses one below its floor; the others ignore it;
-//  - cart_simulate --help shows each row's order, symmetry and reversible control;
+//  - cart_simulate --help shows each row's order, symmetry, reversible and adaptive control;
 // and the names: every member, form and control parses and round-trips through its text, and an
 // unknown one is refused by name with the known list and the closest name.
 #include <gtest/gtest.h>
@@ -40,6 +42,7 @@ constexpr double kForcedCartDuration = 1.0;    // [s]
 constexpr double kPositionTolerance = 1e-5;    // the reversible runs' position tolerance [m]
 constexpr double kWhirlDuration = 2.0;         // the reversible runs' duration [s]
 constexpr double kBelowEveryFloor = 1e-300;    // a local tolerance no adaptive member accepts [-]
+constexpr double kForcedSceneDuration = 3.0;   // the adaptive runs' stretch of drive_rr_drag [s]
 
 Scene load(const std::string& name) { return load_scene(birkhoff_cart_test::scene_path(name)); }
 
@@ -189,6 +192,52 @@ TEST_P(RegistryRow, TheReversibleControlIsBuiltExactlyWhereTheRowOffersIt) {
   EXPECT_GT(simulation.statistics().internal_steps, 0u) << member.name;
 }
 
+TEST_P(RegistryRow, TheAdaptiveControlIsBuiltExactlyWhereTheRowOffersIt) {
+  const IntegratorEntry& member = GetParam();
+  // The rule the refusal states: the Birkhoffian members (their error estimate drives it) and dopri5.
+  const bool birkhoffian =
+      member.kind == IntegratorKind::kBirkhoffianCollocation || member.kind == IntegratorKind::kComposition;
+  EXPECT_EQ(member.adaptive(), birkhoffian || member.kind == IntegratorKind::kAdaptive) << member.name;
+  // A forced, dissipative stretch: the drive's start-up transient of drive_rr_drag.
+  Scene scene = load("drive_rr_drag");
+  scene.reference = ReferenceSettings{};
+  scene.duration = kForcedSceneDuration;
+  scene.integrator.name = member.name;
+  scene.integrator.step_control = StepControl::kAdaptive;
+  scene.integrator.position_tolerance = kPositionTolerance;
+  scene.integrator.tolerance_horizon = kForcedSceneDuration;
+  scene.integrator.step_size = kForcedSceneDuration;
+  if (!member.adaptive()) {
+    try {
+      Simulation refused(scene);
+      FAIL() << member.name << " was built under the adaptive step control";
+    } catch (const std::invalid_argument& error) {
+      const std::string message = error.what();
+      EXPECT_NE(message.find("'" + std::string(member.name) + "'"), std::string::npos) << message;
+      for (const std::string& name : adaptive_integrator_names()) {
+        EXPECT_NE(message.find(name), std::string::npos) << message;
+      }
+    }
+    return;
+  }
+  Simulation simulation(scene);
+  EXPECT_TRUE(simulation.takes_own_steps()) << member.name;
+  simulation.advance_output_to(simulation.end_time());
+  Scene reference_scene = scene;
+  reference_scene.integrator = IntegratorSettings{};
+  reference_scene.integrator.name = "birkhoff_gauss8";
+  reference_scene.integrator.step_size = 1e-3;
+  const CartState reference = run_to_end(reference_scene);
+  const double error = std::hypot(simulation.state().x - reference.x, simulation.state().y - reference.y);
+  std::printf("[ measured ] %s adaptive at %.0e m over %.0f s of drive_rr_drag: position error %.3e m in %llu internal "
+              "steps, %llu rejected\n",
+              member.name, kPositionTolerance, kForcedSceneDuration, error,
+              static_cast<unsigned long long>(simulation.statistics().internal_steps),
+              static_cast<unsigned long long>(simulation.statistics().rejected_steps));
+  EXPECT_LT(error, 10.0 * kPositionTolerance) << member.name;
+  EXPECT_GT(simulation.statistics().internal_steps, 0u) << member.name;
+}
+
 TEST_P(RegistryRow, OnlyARowThatTakesAToleranceReadsIt) {
   const IntegratorEntry& member = GetParam();
   const CartModel model{CartParameters{}};
@@ -203,7 +252,7 @@ TEST_P(RegistryRow, OnlyARowThatTakesAToleranceReadsIt) {
   }
 }
 
-TEST_P(RegistryRow, HelpShowsTheRowsOrderSymmetryAndReversibleControl) {
+TEST_P(RegistryRow, HelpShowsTheRowsOrderSymmetryAndStepControls) {
   const IntegratorEntry& member = GetParam();
   const std::string help =
       birkhoff_cart_test::standard_output_of("'" + birkhoff_cart_test::cart_simulate_path() + "' --help");
@@ -211,13 +260,14 @@ TEST_P(RegistryRow, HelpShowsTheRowsOrderSymmetryAndReversibleControl) {
   const auto at = help.find(start);
   ASSERT_NE(at, std::string::npos) << member.name << " has no row in cart_simulate --help:\n" << help;
   std::istringstream row(help.substr(at + 1, help.find('\n', at + 1) - at - 1));
-  std::string name, symmetric, reversible;
+  std::string name, symmetric, reversible, adaptive;
   int order = 0;
-  row >> name >> order >> symmetric >> reversible;
+  row >> name >> order >> symmetric >> reversible >> adaptive;
   EXPECT_EQ(name, member.name);
   EXPECT_EQ(order, member.order) << member.name;
   EXPECT_EQ(symmetric, member.symmetric ? "yes" : "no") << member.name;
   EXPECT_EQ(reversible, member.reversible() ? "yes" : "no") << member.name;
+  EXPECT_EQ(adaptive, member.adaptive() ? "yes" : "no") << member.name;
   EXPECT_NE(help.find(member.description, at), std::string::npos) << member.name;
   EXPECT_NE(help.find(to_string(member.kind), at), std::string::npos) << member.name;
 }
@@ -240,7 +290,7 @@ TEST(IntegratorNames, AreTheTablesAndEachFindsItsRow) {
   const std::vector<std::string> names = integrator_names();
   ASSERT_EQ(names.size(), integrator_registry().size());
   EXPECT_EQ(std::set<std::string>(names.begin(), names.end()).size(), names.size()) << "a name appears twice";
-  std::vector<std::string> reversible;
+  std::vector<std::string> reversible, adaptive;
   for (std::size_t i = 0; i < names.size(); ++i) {
     const IntegratorEntry& member = integrator_registry()[i];
     EXPECT_EQ(names[i], member.name);
@@ -248,8 +298,10 @@ TEST(IntegratorNames, AreTheTablesAndEachFindsItsRow) {
     EXPECT_EQ(&integrator_entry(names[i]), &member) << names[i];
     EXPECT_FALSE(std::string(member.description).empty()) << names[i];
     if (member.reversible()) reversible.push_back(member.name);
+    if (member.adaptive()) adaptive.push_back(member.name);
   }
   EXPECT_EQ(reversible_integrator_names(), reversible);
+  EXPECT_EQ(adaptive_integrator_names(), adaptive);
 }
 
 TEST(IntegratorNames, AnUnknownNameIsRefusedByNameWithTheKnownOnesAndTheClosest) {

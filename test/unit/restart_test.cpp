@@ -9,6 +9,7 @@
 #include <limits>
 #include <string>
 
+#include "birkhoff_cart/core/restart_state.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
 
@@ -161,6 +162,61 @@ TEST(Restart, RefusesByNameAndLeavesTheRunUntouched) {
   target = load("paper_special").initial_state;
   target.forward_speed = 2.0;
   expect_refused(load("paper_special"), target, "paper_analytic");
+}
+
+TEST(Restart, RefusesStatesNoStepResolvesByName) {
+  // Regression: ~set_state 1 1 0 0 1e200 0 was accepted and the next step killed the node;
+  // x = 1e20 (the cart never moved again), heading and chi 1e300, 1e6 m/s were accepted too.
+  const Scene scene = load("default");  // h = 10 ms, l = 1.05 m
+  struct Case {
+    const char* field;
+    double CartState::*member;
+    double value;
+    const char* expected;
+  };
+  const Case cases[] = {
+      {"forward_speed", &CartState::forward_speed, 1e200, "forward_speed 1e+200 m/s is beyond +-10.5 m/s"},
+      {"forward_speed", &CartState::forward_speed, -1e6, "forward_speed -1e+06 m/s is beyond +-10.5 m/s"},
+      {"steering_rate", &CartState::steering_rate, 1e6, "steering_rate 1e+06 rad/s is beyond +-10 rad/s"},
+      {"x", &CartState::x, 1e20, "x 1e+20 m is beyond +-1e+06 m"},
+      {"y", &CartState::y, -2e6, "y -2e+06 m is beyond +-1e+06 m"},
+      {"heading", &CartState::heading, 1e300, "heading 1e+300 rad is beyond +-1e+06 rad"},
+      {"steering_angle", &CartState::steering_angle, 1e300, "steering_angle 1e+300 rad is beyond +-1e+06 rad"},
+  };
+  for (const Case& c : cases) {
+    CartState target = teleport_target(0.5);
+    target.*c.member = c.value;
+    expect_refused(scene, target, c.expected);
+  }
+  // Just inside the limits: accepted, and the run steps on (every member steps 3000 steps from the
+  // corners of these limits on the shipped scenes, restart_state.h).
+  Simulation simulation(scene);
+  CartState target = teleport_target(0.0);
+  target.steering_angle = M_PI - 1e-3;  // jackknifed
+  target.forward_speed = 0.999 * kLargestStepFraction * 1.05 / 0.01;
+  target.steering_rate = -0.999 * kLargestStepFraction / 0.01;
+  ASSERT_NO_THROW(simulation.restart_from(target));
+  for (int k = 0; k < 300; ++k) ASSERT_NO_THROW(simulation.step()) << "step " << k;
+}
+
+TEST(Restart, RefusesAStateWhoseTrialStepFailsAndKeepsTheRun) {
+  // A command no step survives (the node clamps commands; the core does not): the teleport's trial
+  // step fails and names why, and the run is as it was.
+  const Scene scene = load("driven");
+  Simulation simulation(scene);
+  for (int k = 0; k < 20; ++k) simulation.step();
+  simulation.set_steering_command(1e300);
+  const CartState before = simulation.state();
+  try {
+    simulation.restart_from(teleport_target(before.time));
+    ADD_FAILURE() << "accepted a restart whose first step fails";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("restart state: a trial step of h = 0.001 s from it fails: "),
+              std::string::npos)
+        << error.what();
+  }
+  EXPECT_TRUE(bit_identical(simulation.state(), before));
+  EXPECT_EQ(simulation.steps_taken(), 20u);
 }
 
 }  // namespace

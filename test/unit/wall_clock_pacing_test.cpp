@@ -39,6 +39,15 @@ TEST(WallClockPacing, ResetDeadlinesFollowTheNewAnchor) {
   EXPECT_NEAR(pacing.scene_time_at(at(5.5)), 0.5, kTimeTolerance);
 }
 
+TEST(WallClockPacing, ATinyFactorPutsTheDueInstantFarAwayNotIntoOverflow) {
+  // Regression: ~real_time_factor 1e-300 made (t - t_anchor) / factor 1e298 s, whose conversion to
+  // int64 nanoseconds overflowed (undefined; the deadline came out in the past or anywhere).
+  WallClockPacing pacing(1e-300);
+  pacing.restart(at(100.0), 5.0);
+  EXPECT_NEAR(seconds(pacing.due(5.001)), 100.0 + WallClockPacing::kFarthestDue, 1e-3);
+  EXPECT_GT(pacing.due(5.001), pacing.due(5.0));
+}
+
 TEST(WallClockPacing, PauseDoesNotAccumulateADebt) {
   WallClockPacing pacing(1.0);
   pacing.restart(at(0.0), 0.0);

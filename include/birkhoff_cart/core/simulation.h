@@ -80,10 +80,11 @@ class Simulation {
   /// reference (rebuilt from the new state), the invariants' initial values and the balances'
   /// integrals (applied_work, steering_impulse start at 0); the schedule is
   /// t₀' + the scene's duration; commands keep their values. Refuses, leaving everything as it was,
-  /// with std::invalid_argument naming the problem: a non-finite field, a state where the next step
-  /// would meet a singular steering angle (the paper's special case at χ = kπ, docs/hard_cases.md §1),
-  /// a reference that cannot start there (paper_analytic off its analytic state), a time beyond the
-  /// limits of step_schedule.h.
+  /// with std::invalid_argument naming the problem: a state that breaks check_restart_state()
+  /// (non-finite, beyond the ranges a step resolves, a singular steering angle within the next step
+  /// as in the paper's special case at χ = kπ, docs/hard_cases.md §1, beyond the end stops); a state
+  /// from which a trial step fails (check_trial_step()); a reference that cannot start there
+  /// (paper_analytic off its analytic state); a time beyond the limits of step_schedule.h.
   void restart_from(const CartState& initial_state);
 
   /// For a member with its own steps (integrator.step_control adaptive or reversible; dopri5, one
@@ -149,6 +150,10 @@ class Simulation {
   /// events (docs/actuators.md §4).
   void take_step_with_events(double next_time);
   std::uint64_t end_stop_events_ = 0;
+  /// A step of h from `run_scene`'s initial state with a stepper of its own; throws
+  /// std::invalid_argument ("a trial step ... fails: ...") when it throws a StepError or ends with a
+  /// non-finite energy. Changes nothing.
+  void check_trial_step(const Scene& run_scene);
   /// Builds the schedule, reference and stepper of a run of `run_scene` from its initial state and
   /// commits them with zeroed counters and the invariants' initial values (reset(), restart_from()).
   /// Throws, with nothing changed, when the reference or the reversible control refuses the state.

@@ -16,20 +16,19 @@
 //    there, so a closed loop through another node is the same on every run.
 //
 // Parts with a job of their own are classes: CommandInputs (the command topics, their watchdogs and
-// the lockstep answers), StepRequests (~step on its own thread), RunRecord (the bag of each run and
-// its failure), RunWorkMeter (what the run costs in wall time), InstantPublisher (the topics of a
-// publish instant, /clock and tf, and what of them goes into the bag), CartSimReports (/diagnostics,
-// the progress lines, the summary), PoseRequests (~set_state and initialpose), RunSettings (what
-// dynamic_reconfigure may change while running).
-// The member functions are defined by job: cart_sim_node.cpp (construction and the time loop),
-// cart_sim_pacing.cpp (callbacks, real-time deadlines, the lockstep barrier, following /clock),
-// cart_sim_publishing.cpp, cart_sim_services.cpp (~reset, ~pause), cart_sim_teleport.cpp
-// (a restart of the run from a new state).
+// the lockstep answers), StepRequests (~step on its own threads), RunRecord (the bag of each run and
+// its failure), RunWorkMeter (what the run costs in wall time), RunTimeline (where the run starts
+// and ends, and the ROS-time rules), InstantPublisher (the topics of a publish instant, /clock and
+// tf, and what of them goes into the bag), CartSimReports (/diagnostics, the progress lines, the
+// summary), PoseRequests (~set_state and initialpose), RunSettings (what dynamic_reconfigure may
+// change while running). Every restart of the run (~reset, ~set_state, initialpose, a follower
+// moved onto its leader's clock) goes through restart_run().
 #pragma once
 
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -62,6 +61,7 @@
 #include "birkhoff_cart/ros/shutdown_signals.h"
 #include "birkhoff_cart/ros/signaling_callback_queue.h"
 #include "birkhoff_cart/ros/step_requests.h"
+#include "birkhoff_cart/core/node_logic/run_timeline.h"
 #include "birkhoff_cart/core/node_logic/wall_clock_pacing.h"
 
 namespace birkhoff_cart {
@@ -100,33 +100,43 @@ class CartSimNode {
   /// The record has failed (the node stops: it does not run without its record).
   bool record_failed() const;
 
-  // cart_sim_services.cpp
+  /// Whether a restart starts a whole run (T long: construction, ~reset, a follower's start on its
+  /// leader's clock) or the rest of one (up to the end in force: a teleport).
+  enum class RunStart { kWhole, kRest };
+  /// The one restart of the run: `move` moves the simulation to the new run's start
+  /// (Simulation::reset or restart_from; std::invalid_argument refuses, with nothing changed);
+  /// then the accuracy guard, the commands' hold, the plan, the publish instants and the pacing
+  /// start again there and an open ~step is cancelled. False, with `message` naming the refusal
+  /// ("<source> refused: ..."), when `move` refused.
+  bool restart_run(const std::string& source, RunStart start, const std::function<void()>& move,
+                   std::string& message);
+  /// Plans the run in the simulation from the current state (Simulation::plan_run: a whole run or
+  /// the rest of one) and restarts the publish instants and the pacing there. The simulation then
+  /// owns the schedule: at_end(), next_step_time().
+  void restart_schedule(RunStart start);
+
   bool on_reset(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   bool on_pause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
-
-  // cart_sim_teleport.cpp
-  /// Restarts the run from `target` at the current time (Simulation::restart_from) and restarts the
-  /// commands' hold, the accuracy guard, the schedule and the publish instants there; the bag goes
+  /// ~reset's work (also a follower's when its leader's /clock goes back): the scene's initial
+  /// state, the next run's bag; a follower then starts on its leader's clock, catching up at most
+  /// `catch_up` [s] of the leader's lead by stepping.
+  void reset_run(const std::string& source, double catch_up);
+  /// Restarts the run from `target` at the current time (Simulation::restart_from); the bag goes
   /// on. False, with `message` naming the problem and nothing changed, when it is refused.
   bool teleport(const CartState& target, const std::string& source, std::string& message);
   /// Paused with no ~step request open: the loop waits.
   bool halted() const { return paused_ && !step_requests_->open(); }
+  /// The batch in progress must stop: paused, the record failed, stopping, a restart since
+  /// `restarts_before` (its publish instants belonged to the old start) or the leader's clock went back.
+  bool batch_interrupted(std::uint64_t restarts_before) const;
 
-  // cart_sim_node.cpp
-  /// Plans the run in the simulation from the current state (Simulation::plan_run; construction,
-  /// ~reset, a teleport: the simulation's step count is 0) and restarts the publish instants and
-  /// the pacing there. The simulation then owns the schedule: at_end(), next_step_time().
-  void restart_schedule();
   /// Into the bag (while it can be written): a command message at scene time `time` [s].
   void record_command(const std::string& topic, double time, const std_msgs::Float64& message);
   /// The next step of the run's schedule (watchdogs first); false when it failed (step_failure_ set).
   bool take_step();
-
-  // cart_sim_publishing.cpp
   /// One publish instant: the guard checked, the state published and recorded, /diagnostics when due.
   void publish_instant();
 
-  // cart_sim_pacing.cpp
   /// Runs the queued callbacks (commands, services) now.
   void process_callbacks();
   /// Real-time mode: sleeps until scene time `time` [s] is due or a message arrives; runs the
@@ -143,6 +153,13 @@ class CartSimNode {
   /// ~follow_clock: waits until the /clock another node drives reaches scene time `time` [s] (the
   /// end of the next batch of steps), so this cart's stamps are instants of that clock, never ahead.
   void wait_for_clock(double time);
+  /// ~follow_clock, at the start of a whole run: once a /clock is heard, moves the run's start onto
+  /// the leader's clock (start_on_leader_clock) instead of replaying the leader's past in a burst.
+  /// True when the start moved (a new batch begins).
+  bool start_on_leader_clock_if_behind();
+  /// /clock from the leader (~follow_clock): this process's ROS time; a clock that goes back (the
+  /// leader was reset) is noted for the loop, which resets this cart too.
+  void hear_clock(const rosgraph_msgs::Clock::ConstPtr& clock);
 
   ros::NodeHandle node_;
   ros::NodeHandle private_node_;
@@ -160,12 +177,10 @@ class CartSimNode {
   ros::ServiceServer reset_service_;
   ros::ServiceServer pause_service_;
   std::optional<PoseRequests> pose_requests_;  ///< ~set_state and initialpose, teleporting through teleport()
-  std::unique_ptr<StepRequests> step_requests_;  ///< ~step, on a thread of its own
+  std::unique_ptr<StepRequests> step_requests_;  ///< ~step, on threads of its own
   std::optional<RunSettings> settings_;  ///< what dynamic_reconfigure may change while running
 
-  double run_duration_ = 0.0;             ///< T: the run's length from its start [s]; +inf = without end
-  double end_time_ = 0.0;                 ///< t0 + T, where the run stops exactly [s]; +inf = never
-  double loaded_start_time_ = 0.0;        ///< the scene's t0 [s] (a teleport starts the run's rest elsewhere)
+  std::optional<RunTimeline> timeline_;   ///< where the run started and stops, the ROS-time rules
   double publish_period_ = 0.01;          ///< [s]
   WallClockPacing pacing_;
   std::uint64_t next_publish_index_ = 1;  ///< k of the next publish instant t0 + k/publish_rate
@@ -173,7 +188,12 @@ class CartSimNode {
   bool clock_started_ = false;            ///< the first /clock (t0 + h) went out
   std::atomic<bool> paused_{false};  ///< read by the ~step thread
   std::atomic<bool> stop_flag_{false};  ///< request_stop()
-  std::uint64_t resets_ = 0;              ///< ~reset calls served
+  std::uint64_t restarts_ = 0;            ///< restarts of the run (~reset, teleports, a follower's move)
+  /// ~follow_clock: a whole run waits to start on the leader's clock, catching up at most this lag
+  /// [s] by stepping (start_on_leader_clock); none: it has started.
+  std::optional<double> start_catch_up_;
+  bool leader_clock_went_back_ = false;  ///< ~follow_clock: the leader's /clock went back (heard on the loop's thread)
+  double leader_clock_before_ = 0.0;      ///< the leader's /clock before it went back [s]
   std::optional<std::string> step_failure_;
 
   std::uint64_t lockstep_timeouts_ = 0;  ///< lockstep instants that went on without every answer

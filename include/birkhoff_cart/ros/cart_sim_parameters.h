@@ -34,7 +34,7 @@ struct CartSimParameters {
   std::uint64_t min_free_disk_space = 16u << 20;  ///< ~min_free_disk_space: refuse to record below [bytes]; 0 = no check
   std::string summary_path;                  ///< ~summary_path: also write the final summary here; "" = no file
   std::string frame_prefix;                  ///< ~frame_prefix: before every frame and joint name ("cart1/")
-  ros_conversions::FrameNames frames;        ///< ~frame_prefix + ~odom_frame, ~frame_prefix + ~base_frame, ~world_frame
+  ros_conversions::FrameNames frames;        ///< ~frame_prefix + ~odom_frame, ~base_frame, ~ground_truth_frame; ~world_frame
   ros_conversions::OdometryCovariance odometry_covariance;  ///< ~pose/twist_covariance_diagonal
   bool publish_tf = true;                    ///< ~publish_tf: odom → base_link on /tf
   bool publish_world_tf = true;              ///< ~publish_world_tf: the identity ~world_frame → odom on /tf_static

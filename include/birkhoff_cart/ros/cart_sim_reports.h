@@ -18,6 +18,7 @@
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
 #include "birkhoff_cart/ros/command_inputs.h"
 #include "birkhoff_cart/ros/run_record.h"
+#include "birkhoff_cart/core/node_logic/run_timeline.h"
 #include "birkhoff_cart/core/node_logic/run_work_meter.h"
 
 namespace birkhoff_cart {
@@ -34,7 +35,7 @@ struct RunView {
   const std::atomic<bool>& paused;
   const std::optional<std::string>& step_failure;
   const std::uint64_t& lockstep_timeouts;  ///< lockstep instants that went on without every answer
-  const double& end_time;                  ///< where the run stops [s]; +inf = never
+  const RunTimeline& timeline;             ///< where the run started and stops
 };
 
 class CartSimReports {

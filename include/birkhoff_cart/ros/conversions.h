@@ -11,6 +11,7 @@
 #include <ros/time.h>
 #include <sensor_msgs/JointState.h>
 
+#include "birkhoff_cart/core/node_logic/run_timeline.h"
 #include "birkhoff_cart/IntegrationError.h"
 #include "birkhoff_cart/core/sensors/odometry_sensor.h"
 #include "birkhoff_cart/core/cart_model.h"
@@ -29,14 +30,18 @@ const std::array<std::string, 5>& joint_names();
 struct FrameNames {
   std::string odom = "odom";            ///< fixed frame
   std::string base_link = "base_link";  ///< rear-axle midpoint A on the ground
+  /// The ground truth's child frame: A where it truly is, in the world frame (base_link is where the
+  /// odometry believes it is; one frame pair, one source).
+  std::string ground_truth = "base_link_ground_truth";
   std::string joint_prefix;             ///< before every joint name in joint_states ("" = the URDF's)
   /// The world frame of the ground truth (REP-105 map; not prefixed: carts share the world). The
   /// odometry starts at the true pose, so world → odom is the identity (docs/odometry_sensor.md).
   std::string world = "map";
 };
 
-/// `prefix` + odom, `prefix` + base_link, and `prefix` as the joint prefix.
-FrameNames prefixed_frames(const std::string& prefix, const std::string& odom, const std::string& base_link);
+/// `prefix` + odom, `prefix` + base_link, `prefix` + ground_truth, and `prefix` as the joint prefix.
+FrameNames prefixed_frames(const std::string& prefix, const std::string& odom, const std::string& base_link,
+                           const std::string& ground_truth = "base_link_ground_truth");
 
 /// The variances the odometry claims (diagonals of its pose and twist covariances, in the order
 /// x, y, z, roll, pitch, yaw) [m², rad²; (m/s)², (rad/s)²]. cart_sim's ~pose_covariance_diagonal and
@@ -56,7 +61,7 @@ struct ActuatorEfforts {
 };
 
 /// The end of ROS time: ros::Time holds unsigned 32-bit seconds, so t < 2^32 − 1 s [s].
-constexpr double kLatestRosTime = 4294967295.0;
+constexpr double kLatestRosTime = birkhoff_cart::kLatestRosTime;
 
 /// Scene time t [s] as ROS time (scene time t is ROS time t). Throws std::invalid_argument for a
 /// negative or non-finite time, or one at or past kLatestRosTime.

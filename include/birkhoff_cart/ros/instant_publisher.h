@@ -16,6 +16,7 @@
 #include "birkhoff_cart/core/simulation.h"
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
 #include "birkhoff_cart/ros/instant_messages.h"
+#include "birkhoff_cart/ros/output.h"
 #include "birkhoff_cart/ros/run_record.h"
 
 namespace birkhoff_cart {
@@ -39,27 +40,20 @@ class InstantPublisher {
   void restart() { last_transform_stamp_ = ros::Time(); }
 
   /// Subscribers of joint_states (lockstep waits for its controller).
-  std::uint32_t joint_state_subscribers() const { return joint_state_publisher_.getNumSubscribers(); }
+  std::uint32_t joint_state_subscribers() const { return joints_.subscribers(); }
   /// Someone subscribes to a topic of an instant (odom, ground_truth, joint_states,
   /// integration_error, /clock, /tf): the last instant's messages have somewhere to go.
   bool listened() const;
 
  private:
-  static constexpr const char* kTransformTopic = "/tf";
-
   const CartSimParameters& parameters_;
-  ros::Publisher odometry_publisher_;
-  ros::Publisher ground_truth_publisher_;
-  ros::Publisher joint_state_publisher_;
-  ros::Publisher integration_error_publisher_;
-  ros::Publisher clock_publisher_;
-  ros::Publisher transform_publisher_;         ///< /tf (tf2_msgs/TFMessage), as tf2_ros::TransformBroadcaster advertises it
-  ros::Publisher static_transform_publisher_;  ///< /tf_static, latched: the identity world → odom
-  /// The topics as recorded in the bag (resolved names, kept: Publisher::getTopic() returns a copy).
-  std::string odometry_topic_;
-  std::string ground_truth_topic_;
-  std::string joint_state_topic_;
-  std::string integration_error_topic_;
+  Output<nav_msgs::Odometry> odometry_;
+  Output<nav_msgs::Odometry> ground_truth_;
+  Output<sensor_msgs::JointState> joints_;
+  Output<IntegrationError> integration_error_;
+  Output<rosgraph_msgs::Clock> clock_;       ///< with ~publish_clock
+  Output<tf2_msgs::TFMessage> transforms_;   ///< /tf (tf2_msgs/TFMessage), as tf2_ros::TransformBroadcaster advertises it
+  Output<tf2_msgs::TFMessage> static_transforms_;  ///< /tf_static, latched: the identity world → odom
   tf2_msgs::TFMessage world_transform_;  ///< world → odom, published once and recorded into each bag
   InstantMessages messages_;             ///< filled in place at each publish instant
   rosgraph_msgs::Clock clock_message_;

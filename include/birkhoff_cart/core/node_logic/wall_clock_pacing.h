@@ -4,6 +4,7 @@
 // run (before, a reset kept the old deadline: /clock stalled, then fast-forwarded).
 #pragma once
 
+#include <algorithm>
 #include <chrono>
 
 namespace birkhoff_cart {
@@ -23,11 +24,16 @@ class WallClockPacing {
     anchor_wall_ = wall;
     anchor_time_ = scene_time;
   }
-  /// The wall instant at which scene time `scene_time` [s] is due (paced() only).
+  /// The wall instant at which scene time `scene_time` [s] is due (paced() only); at most
+  /// kFarthestDue after the anchor (a tiny factor would overflow the clock's integer nanoseconds).
   Clock::time_point due(double scene_time) const {
-    return anchor_wall_ + std::chrono::duration_cast<Clock::duration>(
-                              std::chrono::duration<double>((scene_time - anchor_time_) / factor_));
+    const double seconds = std::min((scene_time - anchor_time_) / factor_, kFarthestDue);  // [s]
+    return anchor_wall_ + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
   }
+
+  /// The farthest a due instant lies after the anchor [s of wall time] (≈ 32 years; int64
+  /// nanoseconds reach 292 years).
+  static constexpr double kFarthestDue = 1e9;
   /// The scene time [s] due at `wall` (paced() only).
   double scene_time_at(Clock::time_point wall) const {
     return anchor_time_ + factor_ * std::chrono::duration<double>(wall - anchor_wall_).count();
