@@ -1,7 +1,11 @@
 // The list of parameters cart_sim reads (cart_sim_parameter_names(), behind its "did you mean"
 // report of a misspelled parameter) is the list load_parameters() reads: every name it passes to a
 // reader appears in the list and every listed name is read, so a parameter added later is not
-// reported as a typo and a parameter removed is no longer accepted in silence.
+// reported as a typo and a parameter removed is no longer accepted in silence. And the parameter
+// table of docs/ros_interface.md ("### Parameters (all private)" of cart_sim) holds exactly that list:
+// every `~name` of its first column is a name cart_sim reads, and every name it reads has its row
+// (dynamic_reconfigure's copies of the guard limits as the `<quantity>_warn` / `<quantity>_error`
+// of a quantity the `~accuracy/<quantity>` row names).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,6 +13,7 @@
 #include <iterator>
 #include <regex>
 #include <set>
+#include <sstream>
 #include <utility>
 #include <string>
 
@@ -69,6 +74,41 @@ TEST(CartSimParameterNames, AreExactlyTheNamesLoadParametersReads) {
   }
   for (const std::string& name : read_names) EXPECT_EQ(listed.count(name), 1u) << "~" << name << " is read but not listed";
   for (const std::string& name : listed) EXPECT_EQ(read_names.count(name), 1u) << "~" << name << " is listed but not read";
+}
+
+TEST(CartSimParameterNames, AreTheRowsOfTheParameterTableOfRosInterfaceMd) {
+  std::ifstream file(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/docs/ros_interface.md");
+  ASSERT_TRUE(file.good());
+  const std::string page((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  const auto section = page.find("## Node `cart_sim`");
+  const auto heading = page.find("### Parameters (all private)", section);
+  ASSERT_NE(heading, std::string::npos);
+  const auto table = page.find("\n|", heading);
+  const auto table_end = page.find("\n\n", table);
+  std::istringstream rows(page.substr(table + 1, table_end - table - 1));
+  std::set<std::string> documented;
+  std::string accuracy_row;
+  const std::regex parameter(R"(`~([a-z_0-9/]+)(<quantity>)?`)");
+  for (std::string row; std::getline(rows, row);) {
+    const std::string first = row.substr(0, row.find(" |", 2));
+    for (auto it = std::sregex_iterator(first.begin(), first.end(), parameter); it != std::sregex_iterator(); ++it) {
+      documented.insert((*it)[1]);
+      if ((*it)[1] == "accuracy/") accuracy_row = row;
+    }
+  }
+  ASSERT_GE(documented.size(), 30u) << "the pattern no longer finds the table's rows";
+  const std::set<std::string> listed(cart_sim_parameter_names().begin(), cart_sim_parameter_names().end());
+  for (const std::string& name : documented) EXPECT_EQ(listed.count(name), 1u) << "~" << name << " is documented but not read";
+  ASSERT_FALSE(accuracy_row.empty()) << "no row of ~accuracy/<quantity>";
+  for (const std::string& name : listed) {
+    if (documented.count(name) != 0) continue;
+    // dynamic_reconfigure's copies: <quantity>_warn, <quantity>_error of a quantity the row names.
+    std::smatch copy;
+    const bool is_copy = std::regex_match(name, copy, std::regex("(.+)_(warn|error)")) &&
+                         accuracy_row.find("`" + copy[1].str() + "`") != std::string::npos;
+    EXPECT_TRUE(is_copy)
+        << "~" << name << " is read by cart_sim but has no row in docs/ros_interface.md";
+  }
 }
 
 }  // namespace
