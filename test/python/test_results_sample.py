@@ -1,0 +1,152 @@
+"""docs/results.md describes the landed build: the work–precision page records the source commit it
+was written from, and a fixed sample of its rows (bench/results/work_precision/rows.jsonl, the rows
+the page is generated from) measured again with the current build gives the same errors and
+evaluation counts, bit for bit (times are not compared). A change that moves them fails here until
+the page is regenerated (docs/benchmarks.md: `bash scripts/run_benchmark.sh`, then the page and its
+rows are committed with the change).
+
+The sample: one row of every registry member and step control and of each Boost.Odeint peer family,
+on the short scenes (paper_special against its closed form; sine_steer_torque, drive_rr_drag and
+very_stiff_hinge against their references, which are measured again too and must give the shipped
+reference files): about 30 runs of milliseconds each. Each runs as the study runner runs it (the
+study's own tasks, wired by its work_precision kind, one process each), with one repetition.
+
+Run by scripts/run_tests.sh (pytest-test_results_sample.xml), or after `source .ws/devel/setup.bash`:
+python3 -m pytest test/python/test_results_sample.py."""
+import os
+import pathlib
+import re
+import subprocess
+import sys
+
+import pytest
+
+REPO = pathlib.Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(REPO / "src"))
+
+from birkhoff_cart_study.engine import latest_rows, read_rows  # noqa: E402
+from birkhoff_cart_study.kinds import work_precision  # noqa: E402
+from birkhoff_cart_study import report  # noqa: E402
+from birkhoff_cart_study.registry import read_registry  # noqa: E402
+from birkhoff_cart_study.study import load_study  # noqa: E402
+
+BIN = pathlib.Path(os.environ.get("BIRKHOFF_CART_BIN_DIR", REPO / ".ws" / "devel" / "lib" / "birkhoff_cart"))
+PAGE = REPO / "docs" / "results.md"
+STUDY = REPO / "bench" / "studies" / "work_precision.yaml"
+ROWS = REPO / "bench" / "results" / "work_precision" / "rows.jsonl"
+
+# (experiment label, method, its setting: a step [s] or a tolerance) of the rows measured again.
+SAMPLE = [
+    ("paper_special", "birkhoff2", 0.0025),
+    ("paper_special", "birkhoff_gauss8", 0.005),
+    ("paper_special", "rk4", 0.0025),
+    ("paper_special", "midpoint", 0.0025),
+    ("paper_special", "birkhoff_gauss8_adaptive", 1e-06),
+    ("paper_special", "dopri5", 1e-08),
+    ("sine_steer_torque", "birkhoff_gauss4", 0.2),
+    ("sine_steer_torque", "birkhoff_gauss6", 0.025),
+    ("sine_steer_torque", "birkhoff4", 0.025),
+    ("sine_steer_torque", "birkhoff4_suzuki", 0.025),
+    ("sine_steer_torque", "birkhoff6_kahan_li", 0.1),
+    ("sine_steer_torque", "birkhoff8_kahan_li", 0.1),
+    ("sine_steer_torque", "rk2", 0.025),
+    ("sine_steer_torque", "birkhoff_gauss6_adaptive", 1e-06),
+    ("sine_steer_torque", "odeint_rkf78", 1e-08),
+    ("sine_steer_torque", "odeint_rk4", 0.025),
+    ("drive_rr_drag", "birkhoff_gauss8", 0.025),
+    ("drive_rr_drag", "birkhoff2", 0.025),
+    ("drive_rr_drag", "birkhoff_gauss4_adaptive", 1e-05),
+    ("drive_rr_drag", "dopri5", 1e-10),
+    ("drive_rr_drag", "odeint_dopri5", 1e-08),
+    ("drive_rr_drag", "odeint_bulirsch_stoer", 1e-08),
+    ("drive_rr_drag", "odeint_bulirsch_stoer_dense_out", 1e-08),
+    ("very_stiff_hinge", "birkhoff_gauss8_reversible", 0.001),
+    ("very_stiff_hinge", "birkhoff_gauss8", 0.005),
+]
+# What a measurement's result holds that depends on the machine and its load, not on the build.
+TIMES = {"cpu_median_s", "wall_median_s", "wall_s", "repetitions"}
+
+
+def page_stage_evaluation():
+    match = re.search(r"^\| stage evaluation \| (scalar|vector) \|$", PAGE.read_text(), re.M)
+    assert match, "docs/results.md records no stage evaluation: regenerate it (docs/benchmarks.md)"
+    return match.group(1)
+
+
+@pytest.fixture(scope="module")
+def study():
+    # The page's errors are those of its stage-evaluation path (the paths agree to round-off only).
+    path = page_stage_evaluation()
+    os.environ.pop("BIRKHOFF_CART_STAGE_EVALUATION", None)
+    assert path == "scalar" or report.stage_evaluation() == "vector", \
+        "docs/results.md was measured on the vector path, which this CPU lacks (AVX2 and FMA): its rows cannot be reproduced here"
+    os.environ["BIRKHOFF_CART_STAGE_EVALUATION"] = path
+    registry = read_registry(str(BIN / "cart_simulate"))
+    doc, tasks = load_study(str(STUDY), registry, str(REPO / "config" / "scenes"))
+    rows = {row["task_id"]: row for row in latest_rows(read_rows(str(ROWS)))}
+    return doc, tasks, rows
+
+
+def sample_task(tasks, label, method, setting):
+    for task in tasks:
+        s = task.settings
+        if (task.kind.value == "measure" and task.label == label and s.get("method") == method
+                and setting in (s.get("step"), s.get("tolerance"))):
+            return task
+    raise AssertionError(f"the study has no run {label} {method} {setting}: update SAMPLE")
+
+
+def measured_again(task, reference_row=None):
+    """The task's row, run now with the current build as the study runner runs it (1 repetition)."""
+    wire = work_precision.wire(task, str(BIN))
+    argv = wire["argv"]
+    if "--repetitions" in argv:
+        argv[argv.index("--repetitions") + 1] = "1"
+    return work_precision.run(wire, reference_row)
+
+
+def test_the_page_records_the_commit_it_was_written_from():
+    text = PAGE.read_text()
+    match = re.search(r"^\| source commit \| `([0-9a-f]{40})`( with changes to \d+ source files?)? \|$", text, re.M)
+    assert match, "docs/results.md records no source commit: regenerate it (docs/benchmarks.md)"
+    assert not match.group(2), "docs/results.md was written from a tree with uncommitted source changes"
+    known = subprocess.run(["git", "-C", str(REPO), "cat-file", "-e", match.group(1) + "^{commit}"],
+                           stderr=subprocess.DEVNULL)
+    if known.returncode == 128 and not (REPO / ".git").exists():
+        pytest.skip("not a git checkout")  # an exported source tree: the commit cannot be looked up
+    assert known.returncode == 0, f"docs/results.md names commit {match.group(1)}, which this repository lacks"
+
+
+def test_the_page_is_generated_from_the_shipped_rows(study):
+    _, tasks, rows = study
+    ids = {task.id for task in tasks}
+    shipped = [row for row in rows.values() if row["task_id"] in ids]
+    assert len(shipped) == len(tasks), "bench/results/work_precision/rows.jsonl lacks rows of the study's tasks"
+    assert f"Generated by the study runner from {len(shipped)} rows" in PAGE.read_text()
+
+
+@pytest.mark.parametrize("label", sorted({label for label, _, _ in SAMPLE} - {"paper_special"}))
+def test_the_reference_is_measured_again_bit_for_bit(study, label):
+    doc, tasks, rows = study
+    name = [e["reference"] for e in doc["experiments"] if e["label"] == label][0]
+    task = [t for t in tasks if t.kind.value == "reference" and t.label == name][0]
+    row = work_precision.run(work_precision.wire(task, str(BIN)))
+    assert row.get("outcome") == "ok", row
+    assert row["reference_text"] == rows[task.id]["reference_text"], f"reference {name} moved: regenerate docs/results.md"
+
+
+@pytest.mark.parametrize("label,method,setting", SAMPLE, ids=[f"{l}-{m}-{s:g}" for l, m, s in SAMPLE])
+def test_a_sample_row_is_measured_again_bit_for_bit(study, label, method, setting):
+    doc, tasks, rows = study
+    task = sample_task(tasks, label, method, setting)
+    shipped = rows[task.id]
+    reference = None
+    if not task.settings.get("analytic"):
+        reference = [r for r in rows.values() if r.get("type") == "reference" and r.get("label") == task.settings["reference"]][0]
+    row = measured_again(task, reference)
+    assert row.get("outcome") == shipped.get("outcome"), row.get("stderr_tail") or row
+    now = {k: v for k, v in row["result"].items() if k not in TIMES}
+    then = {k: v for k, v in shipped["result"].items() if k not in TIMES}
+    moved = {k: (then.get(k), now.get(k)) for k in set(now) | set(then) if now.get(k) != then.get(k)}
+    assert not moved, (f"{label} {method} {setting:g}: the build no longer gives the row docs/results.md shows "
+                       f"(shipped, now): {moved}; regenerate the page (docs/benchmarks.md)")
