@@ -5,12 +5,14 @@
 // table of docs/ros_interface.md ("### Parameters (all private)" of cart_sim) holds exactly that list:
 // every `~name` of its first column is a name cart_sim reads, and every name it reads has its row
 // (dynamic_reconfigure's copies of the guard limits as the `<quantity>_warn` / `<quantity>_error`
-// of a quantity the `~accuracy/<quantity>` row names).
+// of a quantity the `~accuracy/<quantity>` row names). The same for cmd_vel_controller's table and
+// cmd_vel_controller_parameter_names().
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -18,6 +20,7 @@
 #include <string>
 
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
+#include "birkhoff_cart/ros/cmd_vel_controller_node.h"
 
 namespace birkhoff_cart {
 namespace {
@@ -76,38 +79,57 @@ TEST(CartSimParameterNames, AreExactlyTheNamesLoadParametersReads) {
   for (const std::string& name : listed) EXPECT_EQ(read_names.count(name), 1u) << "~" << name << " is listed but not read";
 }
 
-TEST(CartSimParameterNames, AreTheRowsOfTheParameterTableOfRosInterfaceMd) {
+/// The `~name`s in the first column of the first table after `heading` (searched from `section`) of
+/// docs/ros_interface.md (`~accuracy/<quantity>` gives "accuracy/"), each with its row.
+std::map<std::string, std::string> documented_parameters(const std::string& section, const std::string& heading) {
   std::ifstream file(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/docs/ros_interface.md");
-  ASSERT_TRUE(file.good());
   const std::string page((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  const auto section = page.find("## Node `cart_sim`");
-  const auto heading = page.find("### Parameters (all private)", section);
-  ASSERT_NE(heading, std::string::npos);
-  const auto table = page.find("\n|", heading);
+  const auto at = page.find(heading, page.find(section));
+  if (page.find(section) == std::string::npos || at == std::string::npos) return {};
+  const auto table = page.find("\n|", at);
   const auto table_end = page.find("\n\n", table);
   std::istringstream rows(page.substr(table + 1, table_end - table - 1));
-  std::set<std::string> documented;
-  std::string accuracy_row;
+  std::map<std::string, std::string> documented;
   const std::regex parameter(R"(`~([a-z_0-9/]+)(<quantity>)?`)");
   for (std::string row; std::getline(rows, row);) {
     const std::string first = row.substr(0, row.find(" |", 2));
     for (auto it = std::sregex_iterator(first.begin(), first.end(), parameter); it != std::sregex_iterator(); ++it) {
-      documented.insert((*it)[1]);
-      if ((*it)[1] == "accuracy/") accuracy_row = row;
+      documented[(*it)[1]] = row;
     }
   }
+  return documented;
+}
+
+TEST(CartSimParameterNames, AreTheRowsOfTheParameterTableOfRosInterfaceMd) {
+  const auto documented = documented_parameters("## Node `cart_sim`", "### Parameters (all private)");
   ASSERT_GE(documented.size(), 30u) << "the pattern no longer finds the table's rows";
   const std::set<std::string> listed(cart_sim_parameter_names().begin(), cart_sim_parameter_names().end());
-  for (const std::string& name : documented) EXPECT_EQ(listed.count(name), 1u) << "~" << name << " is documented but not read";
-  ASSERT_FALSE(accuracy_row.empty()) << "no row of ~accuracy/<quantity>";
+  for (const auto& [name, row] : documented) EXPECT_EQ(listed.count(name), 1u) << "~" << name << " is documented but not read";
+  ASSERT_EQ(documented.count("accuracy/"), 1u) << "no row of ~accuracy/<quantity>";
+  const std::string& accuracy_row = documented.at("accuracy/");
   for (const std::string& name : listed) {
     if (documented.count(name) != 0) continue;
     // dynamic_reconfigure's copies: <quantity>_warn, <quantity>_error of a quantity the row names.
     std::smatch copy;
     const bool is_copy = std::regex_match(name, copy, std::regex("(.+)_(warn|error)")) &&
                          accuracy_row.find("`" + copy[1].str() + "`") != std::string::npos;
-    EXPECT_TRUE(is_copy)
-        << "~" << name << " is read by cart_sim but has no row in docs/ros_interface.md";
+    EXPECT_TRUE(is_copy) << "~" << name << " is read by cart_sim but has no row in docs/ros_interface.md";
+  }
+}
+
+TEST(CmdVelControllerParameterNames, AreTheRowsOfItsParameterTableOfRosInterfaceMd) {
+  const auto documented = documented_parameters("## Node `cmd_vel_controller`", "| parameter | unit | default | meaning |");
+  ASSERT_GE(documented.size(), 20u) << "the pattern no longer finds the table's rows";
+  const auto& names = cmd_vel_controller_parameter_names();
+  const std::set<std::string> listed(names.begin(), names.end());
+  for (const auto& [name, row] : documented) EXPECT_EQ(listed.count(name), 1u) << "~" << name << " is documented but not read";
+  for (const std::string& name : listed) {
+    // dynamic_reconfigure's copies spell a documented name with '_' for '/' (linear_x_max_velocity).
+    bool documented_as = documented.count(name) != 0;
+    for (const auto& [documented_name, row] : documented) {
+      documented_as = documented_as || std::regex_replace(documented_name, std::regex("/"), "_") == name;
+    }
+    EXPECT_TRUE(documented_as) << "~" << name << " is read by cmd_vel_controller but has no row in docs/ros_interface.md";
   }
 }
 
