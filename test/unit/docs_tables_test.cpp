@@ -3,7 +3,8 @@
 // generated from integrator_registry(): generated_docs.h, BIRKHOFF_CART_WRITE_DOCS=1 rewrites
 // them), the keys of every section of a scene (docs/scenes.md's key tables hold exactly the keys
 // the scene reader allows, as its own "unknown key (allowed here: …)" refusal lists them), the
-// effect table (docs/scenes.md: every row of effect_table() with its coefficient keys), the shipped
+// effect table (docs/scenes.md: every row of effect_table() with its coefficient keys), the torque
+// profiles (their table: every profile the reader knows, each row with the keys it allows), the shipped
 // scenes (docs/scenes.md's table and the tolerance_sweep study cover every file of config/scenes/)
 // and the counts of effects the pages state. A member, key, effect or scene added to the code
 // without its row fails here, and so does a row the code no longer has.
@@ -92,6 +93,27 @@ std::set<std::string> first_column_after(const std::string& markdown, const std:
   return keys;
 }
 
+/// The names the scene reader lists when it refuses the scene `text`: after `marker` ("allowed
+/// here: " for an unknown key, "is not one of: " for an unknown choice), to the end of the list.
+std::set<std::string> names_the_reader_lists(const std::string& text, const std::string& marker) {
+  try {
+    load_scene_text(text, "probe.yaml");
+  } catch (const SceneError& error) {
+    const std::string message = error.what();
+    const auto from = message.find(marker);
+    if (from == std::string::npos) return {"<no list in: " + message + ">"};
+    const auto to = message.find_first_of(")\n", from);
+    std::set<std::string> names;
+    std::string list = message.substr(from + marker.size(), to == std::string::npos ? std::string::npos
+                                                                                      : to - from - marker.size()) + ", ";
+    for (std::size_t at = 0, comma; (comma = list.find(", ", at)) != std::string::npos; at = comma + 2) {
+      names.insert(list.substr(at, comma - at));
+    }
+    return names;
+  }
+  return {"<the probe was accepted>"};
+}
+
 /// The keys the scene reader allows in `section` (after its line `anchor` in a valid scene, or
 /// appended as a new section when `anchor` is empty), read from its refusal of an unknown key.
 std::set<std::string> keys_the_reader_allows(const std::string& anchor, const std::string& section) {
@@ -103,22 +125,7 @@ std::set<std::string> keys_the_reader_allows(const std::string& anchor, const st
   } else {
     text += section + ":\n  zz_probe_key: 1\n";
   }
-  try {
-    load_scene_text(text, "probe.yaml");
-  } catch (const SceneError& error) {
-    const std::string message = error.what();
-    const std::string marker = "allowed here: ";
-    const auto from = message.find(marker);
-    if (from == std::string::npos) return {"<no list in: " + message + ">"};
-    const auto to = message.find(')', from);
-    std::set<std::string> keys;
-    std::string list = message.substr(from + marker.size(), to - from - marker.size()) + ", ";
-    for (std::size_t at = 0, comma; (comma = list.find(", ", at)) != std::string::npos; at = comma + 2) {
-      keys.insert(list.substr(at, comma - at));
-    }
-    return keys;
-  }
-  return {"<the probe key was accepted>"};
+  return names_the_reader_lists(text, "allowed here: ");
 }
 
 TEST(DocsTables, EveryKeyTableOfScenesMdHoldsExactlyTheKeysTheReaderAllows) {
@@ -164,6 +171,23 @@ TEST(DocsTables, TheEffectTableOfScenesMdIsTheEffectLibrarys) {
     }
     if (entry.takes_profile()) {
       EXPECT_NE(row.find("profile"), std::string::npos) << entry.name;
+    }
+  }
+}
+
+TEST(DocsTables, TheTorqueProfileTableOfScenesMdIsTheReaders) {
+  const std::string scenes = page("docs/scenes.md");
+  const std::string effect = minimal_scene("probe", "5.0") + "effects:\n  steering_torque:\n    profile: ";
+  const auto profiles = names_the_reader_lists(effect + "zz_probe\n", "is not one of: ");
+  EXPECT_GE(profiles.size(), 5u) << *profiles.begin();
+  EXPECT_EQ(first_column_after(scenes, "### Torque profiles (`steering_torque`, `drive_torque`)"), profiles);
+  for (const std::string& profile : profiles) {
+    const auto row_at = scenes.find("| `" + profile + "` |");
+    ASSERT_NE(row_at, std::string::npos) << profile;
+    const std::string row = scenes.substr(row_at, scenes.find('\n', row_at) - row_at);
+    for (const std::string& key : names_the_reader_lists(effect + profile + "\n    zz_probe_key: 1\n", "allowed here: ")) {
+      if (key == "profile" || key == "enabled") continue;  // every profile's, stated above the table
+      EXPECT_NE(row.find("`" + key + "`"), std::string::npos) << "the row of profile " << profile << " lacks its key " << key;
     }
   }
 }
