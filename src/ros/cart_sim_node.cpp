@@ -57,6 +57,8 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   }
   if (!parameters_.integrator.empty()) scene.integrator.name = parameters_.integrator;
   if (parameters_.step_size > 0.0) scene.integrator.step_size = parameters_.step_size;
+  if (!parameters_.step_control.empty()) scene.integrator.step_control = parse_step_control(parameters_.step_control);
+  if (parameters_.position_tolerance > 0.0) scene.integrator.position_tolerance = parameters_.position_tolerance;
   try {
     simulation_ = std::make_unique<Simulation>(scene);
   } catch (const std::exception& error) {
@@ -146,11 +148,12 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   paused_ = parameters_.start_paused;
   if (parameters_.follow_clock) start_catch_up_ = kLongestCatchUp;
   restart_schedule(RunStart::kWhole);
-  const std::string step_control = simulation_->scene().integrator.step_control == StepControl::kReversible
-                                       ? " (reversible step control for " +
+  const StepControl control = simulation_->scene().integrator.step_control;
+  const std::string step_control = control == StepControl::kFixed
+                                       ? ""
+                                       : std::string(" (") + to_string(control) + " step control for " +
                                              format_seconds(simulation_->scene().integrator.position_tolerance) +
-                                             " m; h is the output step)"
-                                       : "";
+                                             " m; h is the output step)";
   ROS_INFO("cart_sim: scene '%s' (%s), integrator %s, h = %g s%s, %s mode%s, publish %g Hz, end t = %s s, frames %s -> "
            "%s, %s%s%s",
            simulation_->scene().name.c_str(), parameters_.scene_path.c_str(), simulation_->integrator_name().c_str(),

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "birkhoff_cart/core/integrator_settings.h"
 #include "birkhoff_cart/ros/bag_recorder.h"
 #include "birkhoff_cart/ros/parameter_reading.h"
 
@@ -74,7 +75,7 @@ std::string format_seconds(double value) {
 
 const std::vector<std::string>& cart_sim_parameter_names() {
   static const std::vector<std::string> names = {
-      "scene", "integrator", "step_size", "publish_rate", "fast", "real_time_factor", "duration", "command_timeout",
+      "scene", "integrator", "step_size", "step_control", "position_tolerance", "publish_rate", "fast", "real_time_factor", "duration", "command_timeout",
       "max_steering_torque", "max_drive_torque", "lockstep", "lockstep_topics", "lockstep_timeout", "bag_path",
       "record_wall_time", "bag_compression", "min_free_disk_space", "summary_path", "frame_prefix", "odom_frame",
       "base_frame", "world_frame", "ground_truth_frame", "publish_world_tf", "pose_covariance_diagonal", "twist_covariance_diagonal", "publish_tf", "publish_clock",
@@ -97,6 +98,17 @@ CartSimParameters load_parameters(const ros::NodeHandle& private_node) {
   parameters.step_size = read_double_parameter(p, "step_size", parameters.step_size);
   require(std::isfinite(parameters.step_size) && parameters.step_size >= 0.0,
           "~step_size must be >= 0 s (0 = the scene's)");
+  parameters.step_control = read_parameter<std::string>(p, "step_control", parameters.step_control);
+  if (!parameters.step_control.empty()) {
+    try {
+      parse_step_control(parameters.step_control);
+    } catch (const std::invalid_argument& error) {
+      throw std::invalid_argument("~step_control: " + std::string(error.what()));
+    }
+  }
+  parameters.position_tolerance = read_double_parameter(p, "position_tolerance", parameters.position_tolerance);
+  require(std::isfinite(parameters.position_tolerance) && parameters.position_tolerance >= 0.0,
+          "~position_tolerance must be >= 0 m (0 = the scene's), got " + format_seconds(parameters.position_tolerance));
   parameters.publish_rate = read_double_parameter(p, "publish_rate", parameters.publish_rate);
   // An instant's index k (t0 + k/rate) stays exact in a double over ROS time's 2^32 s up to 2^21 Hz.
   require(std::isfinite(parameters.publish_rate) && parameters.publish_rate > 0.0 &&

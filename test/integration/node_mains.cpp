@@ -3,9 +3,13 @@
 // namespace or remapping roscpp refuses; every node let it escape main (std::terminate, exit 134,
 // no line of its own). steering_driver's timer threw std::runtime_error for ~rate 1e-12 Hz (a
 // period beyond ros::Duration's 2^31 s). Each must now end with exit 2 and a line naming the problem.
-// A parameter of the wrong type names the type it must have and what it got.
+// A parameter of the wrong type names the type it must have and what it got. cart_sim takes a step
+// control and a position tolerance as parameters.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -69,6 +73,41 @@ TEST(CartSim, NamesTheTypeAParameterMustHave) {
     EXPECT_NE(output.find(expected), std::string::npos) << argument << ":\n" << output;
     ros::NodeHandle().deleteParam("/typed_sim");
   }
+}
+
+TEST(CartSim, TakesAStepControlAndAPositionTolerance) {
+  // ~step_control and ~position_tolerance override the scene's (docs/ros_interface.md): refused by
+  // name when unknown or incomplete, and a run under the adaptive control says so in its summary.
+  const std::string scene = std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/default.yaml";
+  const std::vector<std::pair<std::string, std::string>> refused = {
+      {"_step_control:=adaptve",
+       "~step_control: unknown step_control 'adaptve' (known: fixed, reversible, adaptive; did you mean 'adaptive'?)"},
+      {"_step_control:=adaptive", "position_tolerance"},
+      {"_step_control:=adaptive _position_tolerance:=-1", "~position_tolerance must be >= 0 m"},
+      {"_step_control:=reversible _position_tolerance:=1e-6", "reversible"}};  // the default scene's loads vary in time
+  for (const auto& [arguments, expected] : refused) {
+    std::string output;
+    const int status = run_node("cart_sim", "__name:=controlled_sim _scene:=" + scene + " " + arguments, &output);
+    EXPECT_EQ(status, 2) << arguments << ":\n" << output;
+    EXPECT_NE(output.find(expected), std::string::npos) << arguments << ":\n" << output;
+    EXPECT_EQ(output.find("terminate called"), std::string::npos) << output;
+    ros::NodeHandle().deleteParam("/controlled_sim");
+  }
+  const std::string summary = "/tmp/birkhoff_cart_node_mains_" + std::to_string(::getpid()) + "_summary.txt";
+  std::string output;
+  const int status = run_node("cart_sim",
+                              "__name:=controlled_sim _scene:=" + scene +
+                                  " _integrator:=birkhoff_gauss6 _step_control:=adaptive _position_tolerance:=1e-6"
+                                  " _duration:=2 _fast:=true _summary_path:=" + summary,
+                              &output);
+  EXPECT_EQ(status, 0) << output;
+  EXPECT_NE(output.find("adaptive step control for 1e-06 m"), std::string::npos) << output;
+  std::string text;
+  run_command("cat " + summary, &text);
+  EXPECT_NE(text.find("adaptive step control: position tolerance 1e-06 m"), std::string::npos) << text;
+  EXPECT_NE(text.find("final t = 2 s"), std::string::npos) << text;
+  std::remove(summary.c_str());
+  ros::NodeHandle().deleteParam("/controlled_sim");
 }
 
 }  // namespace

@@ -16,7 +16,9 @@ namespace birkhoff_cart {
 struct CartSimParameters {
   std::string scene_path;                    ///< ~scene: scene YAML (required)
   std::string integrator;                    ///< ~integrator: registry name; "" = the scene's
-  double step_size = 0.0;                    ///< ~step_size: h [s]; 0 = the scene's
+  double step_size = 0.0;                    ///< ~step_size: h [s]; 0 = the scene's (under a step control: the output step)
+  std::string step_control;                  ///< ~step_control: fixed, reversible or adaptive; "" = the scene's
+  double position_tolerance = 0.0;           ///< ~position_tolerance: [m] at the end of the run, under a step control; 0 = the scene's
   double publish_rate = 100.0;               ///< ~publish_rate: [Hz of scene time]
   bool fast = false;                         ///< ~fast: lockstep as fast as possible (true) or real time
   double real_time_factor = 0.0;             ///< ~real_time_factor: [-]; 0 = unlimited (fast) / 1 (real time)
