@@ -150,3 +150,26 @@ def test_a_sample_row_is_measured_again_bit_for_bit(study, label, method, settin
     moved = {k: (then.get(k), now.get(k)) for k in set(now) | set(then) if now.get(k) != then.get(k)}
     assert not moved, (f"{label} {method} {setting:g}: the build no longer gives the row docs/results.md shows "
                        f"(shipped, now): {moved}; regenerate the page (docs/benchmarks.md)")
+
+
+def test_the_readme_counts_the_position_goals_the_page_judges():
+    """README.md's "at least 1.2× cheaper than every peer ... in N of the M position goals it judges"
+    is the page's count over the scenes it names (every section but the paper's special case, a
+    check of the closed form rather than a race)."""
+    met = judged = 0
+    for section in re.split(r"^## ", PAGE.read_text(), flags=re.M)[1:]:
+        name = section.split("\n", 1)[0].strip()
+        verdict = re.search(r"^Goal ratio [0-9.]+: .* at \d+ of \d+ goals(?: \(([^)]*)\))?.*$", section, re.M)
+        if name == "paper_special" or verdict is None:
+            continue
+        header = re.search(r"^\| peer \|(.*)$", section, re.M)
+        assert header, f"results.md, section {name}: no goal table"
+        goals = [cell.strip() for cell in header.group(1).split("|") if cell.strip().startswith("error ≤")]
+        unresolved = re.findall(r"No verdict for (error ≤ [^:]+):", section)
+        judged += len([goal for goal in goals if goal not in unresolved])
+        met += len([goal for goal in (verdict.group(1) or "").split(", ") if goal.startswith("error ≤")])
+    readme = (REPO / "README.md").read_text().replace("\n", " ")
+    stated = re.search(r"in (\d+) of the (\d+) position goals it judges", readme)
+    assert stated, "README.md no longer states how many position goals the benchmark judges"
+    assert (int(stated.group(1)), int(stated.group(2))) == (met, judged), \
+        f"README.md says {stated.group(1)} of {stated.group(2)} position goals; docs/results.md shows {met} of {judged}"
