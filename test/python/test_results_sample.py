@@ -1,7 +1,8 @@
 """docs/results.md describes the landed build: the work–precision page records the source commit it
 was written from, and a fixed sample of its rows (bench/results/work_precision/rows.jsonl, the rows
 the page is generated from) measured again with the current build gives the same errors and
-evaluation counts, bit for bit (times are not compared). A change that moves them fails here until
+evaluation counts, bit for bit (times are not compared). The figures other pages quote from it
+(README.md's count of goals met, docs/benchmarks.md's verdicts per goal) are the page's. A change that moves them fails here until
 the page is regenerated (docs/benchmarks.md: `bash scripts/run_benchmark.sh`, then the page and its
 rows are committed with the change).
 
@@ -173,3 +174,37 @@ def test_the_readme_counts_the_position_goals_the_page_judges():
     assert stated, "README.md no longer states how many position goals the benchmark judges"
     assert (int(stated.group(1)), int(stated.group(2))) == (met, judged), \
         f"README.md says {stated.group(1)} of {stated.group(2)} position goals; docs/results.md shows {met} of {judged}"
+
+
+def test_the_benchmark_pages_verdicts_are_the_pages():
+    """docs/benchmarks.md's table of verdicts per position goal (met, missed, no verdict; the worst
+    peer's ratio where missed) is what results.md's "against every peer" rows say."""
+    verdicts = {}
+    for section in re.split(r"^## ", PAGE.read_text(), flags=re.M)[1:]:
+        header = re.search(r"^\| peer \|(.*)$", section, re.M)
+        every = re.search(r"^\| \*against every peer\* \|(.*)$", section, re.M)
+        if header and every:
+            goals = [cell.strip() for cell in header.group(1).split("|")]
+            cells = [cell.strip() for cell in every.group(1).split("|")]
+            verdicts[section.split("\n", 1)[0].strip()] = dict(zip(goals, cells))
+    benchmarks = (REPO / "docs" / "benchmarks.md").read_text()
+    table = re.search(r"^\| scene \| (1e-3 m \| 1e-6 m \| 1e-8 m) \|\n\|[-|]+\|\n((?:\|.*\n)+)", benchmarks, re.M)
+    assert table, "docs/benchmarks.md has no table of verdicts per position goal"
+    goals = ["error ≤ 0.001 m", "error ≤ 1e-06 m", "error ≤ 1e-08 m"]
+    rows = 0
+    for line in table.group(2).strip().split("\n"):
+        cells = [cell.strip() for cell in line.strip("|").split("|")]
+        scene, duration = re.match(r"(\w+), ([\d ]+) s", cells[0]).groups()
+        name = f"{scene}_{duration.replace(' ', '')}s" if scene == "jackknife_whirl" else scene
+        assert name in verdicts, f"benchmarks.md names {cells[0]}, which results.md has no section of"
+        for goal, cell in zip(goals, cells[1:]):
+            page = verdicts[name][goal]
+            kind = "met" if page == "met" else "no verdict" if page.startswith("unresolved") else "missed"
+            shown = "met" if cell.startswith("met") else "no verdict" if cell.startswith("no verdict") else \
+                "missed" if cell.startswith("**missed**") else cell
+            assert shown == kind, f"benchmarks.md, {cells[0]}, {goal}: '{cell}'; results.md: '{page}'"
+            worst = re.search(r"([0-9.]+×)\)$", page)
+            if kind == "missed":
+                assert worst and worst.group(1) in cell, f"benchmarks.md, {cells[0]}, {goal}: '{cell}'; results.md: '{page}'"
+        rows += 1
+    assert rows >= 4
