@@ -208,3 +208,34 @@ def test_the_benchmark_pages_verdicts_are_the_pages():
                 assert worst and worst.group(1) in cell, f"benchmarks.md, {cells[0]}, {goal}: '{cell}'; results.md: '{page}'"
         rows += 1
     assert rows >= 4
+
+
+def shown_matches(shown, value):
+    """A figure as a page shows it ("1.56e-7", "3.70e6", "0.27", "5e5") is `value` rounded to its digits."""
+    match = re.fullmatch(r"(-?\d+)(?:\.(\d+))?(?:e([-+]?\d+))?", shown)
+    assert match, f"not a figure: {shown}"
+    decimals = len(match.group(2) or "")
+    exponent = int(match.group(3) or 0)
+    return abs(float(shown) - value) <= 0.5 * 10.0 ** (exponent - decimals) * (1 + 1e-9)
+
+
+def test_the_reversible_whirl_table_of_accuracy_md_is_the_shipped_run():
+    """docs/accuracy.md §4.2 quotes bench/results/reversible_whirl.csv, the table the command beside
+    it wrote, to the digits it shows (the 10 000 s runs take half a minute: the doc test does not
+    rerun them)."""
+    import csv
+    with open(REPO / "bench" / "results" / "reversible_whirl.csv") as table:
+        runs = {(row["control"], float(row["setting"])): row for row in csv.DictReader(table)}
+    text = (REPO / "docs" / "accuracy.md").read_text()
+    section = text[text.index("### §4.2"):]
+    rows = re.findall(r"^\| (fixed|reversible|adaptive) \| ([0-9.e-]+) (?:s|m) \|(.*)\|$", section, re.M)
+    assert len(rows) >= 9, "accuracy.md §4.2 no longer has its table"
+    columns = ["error_m", "steps", "rhs_evaluations", "cpu_s", "energy_first_tenth_J", "energy_last_tenth_J"]
+    for control, setting, rest in rows:
+        run = runs.get((control, float(setting)))
+        assert run, f"accuracy.md §4.2 shows {control} {setting}, which reversible_whirl.csv lacks"
+        cells = [cell.strip().split(" ")[0] for cell in rest.split("|")]
+        for column, shown in zip(columns + ["ratio"], cells):
+            value = (float(run["energy_last_tenth_J"]) / float(run["energy_first_tenth_J"]) if column == "ratio"
+                     else float(run[column]))
+            assert shown_matches(shown, value), f"accuracy.md §4.2, {control} {setting}, {column}: {shown}; the run: {value}"
