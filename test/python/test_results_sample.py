@@ -2,7 +2,8 @@
 was written from, and a fixed sample of its rows (bench/results/work_precision/rows.jsonl, the rows
 the page is generated from) measured again with the current build gives the same errors and
 evaluation counts, bit for bit (times are not compared). The figures other pages quote from it
-(README.md's count of goals met, docs/benchmarks.md's verdicts per goal) are the page's. A change that moves them fails here until
+(README.md's count of goals met, docs/benchmarks.md's verdicts per goal) are the page's, and
+docs/accuracy.md §4.2 quotes the shipped reversible_whirl table. A change that moves them fails here until
 the page is regenerated (docs/benchmarks.md: `bash scripts/run_benchmark.sh`, then the page and its
 rows are committed with the change).
 
