@@ -203,6 +203,12 @@ TEST(DocsTables, TheCountsOfEffectsThePagesStateAreTheTables) {
   const std::string effects = number_word(effect_table().size());
   EXPECT_NE(page("docs/birkhoffian.md").find("all " + effects + " effects on"), std::string::npos)
       << "docs/birkhoffian.md: the effect table has " << effect_table().size() << " effects";
+  // README.md's "Scenes and effects" names every effect.
+  const std::string readme = page("README.md");
+  const std::string scenes_and_effects = readme.substr(readme.find("## Scenes and effects"));
+  for (const std::string& name : effect_names()) {
+    EXPECT_NE(scenes_and_effects.find("`" + name + "`"), std::string::npos) << "README.md does not name the effect " << name;
+  }
 }
 
 std::set<std::string> shipped_scenes() {
