@@ -170,7 +170,7 @@ def test_the_readme_counts_the_position_goals_the_page_judges():
         unresolved = re.findall(r"No verdict for (error ≤ [^:]+):", section)
         judged += len([goal for goal in goals if goal not in unresolved])
         met += len([goal for goal in (verdict.group(1) or "").split(", ") if goal.startswith("error ≤")])
-    readme = (REPO / "README.md").read_text().replace("\n", " ")
+    readme = re.sub(r"\s+", " ", (REPO / "README.md").read_text())
     stated = re.search(r"in (\d+) of the (\d+) position goals it judges", readme)
     assert stated, "README.md no longer states how many position goals the benchmark judges"
     assert (int(stated.group(1)), int(stated.group(2))) == (met, judged), \
@@ -240,3 +240,37 @@ def test_the_reversible_whirl_table_of_accuracy_md_is_the_shipped_run():
             value = (float(run["energy_last_tenth_J"]) / float(run["energy_first_tenth_J"]) if column == "ratio"
                      else float(run[column]))
             assert shown_matches(shown, value), f"accuracy.md §4.2, {control} {setting}, {column}: {shown}; the run: {value}"
+
+
+def test_accuracy_md_quotes_the_tolerance_sweep_page():
+    """docs/accuracy.md §4.1's summary of the generated tolerance_sweep.md: the runs within 10× of
+    their tolerance, and per member the (member, scene) pairs whose work at 1e-3 m is at most a
+    quarter of their work at 1e-7 m (from the rhs counts the page shows), with the median ratio."""
+    import statistics
+    page = (REPO / "docs" / "tolerance_sweep.md").read_text()
+    accuracy = re.sub(r"\s+", " ", (REPO / "docs" / "accuracy.md").read_text())
+    within = re.search(r"(\d+) of (\d+) judged runs within 10×", page)
+    assert within and f"{within.group(1)} of {within.group(2)} judged runs" in accuracy, \
+        "accuracy.md §4.1 does not quote tolerance_sweep.md's count of runs within 10× of the tolerance"
+    ratios = {}
+    for block in re.split(r"^\*\*", page, flags=re.M)[1:]:
+        control = "reversible" if "reversible" in block.split(",", 1)[0] else "adaptive"
+        for member, cells in re.findall(r"^\| `(\w+)` \|(.*)\|$", block, re.M):
+            work = [re.search(r"\((\d+) rhs\)", cell) for cell in cells.split("|")]
+            if work[0] and work[4]:  # 1e-3 m and 1e-7 m; a refused scene has neither
+                ratios.setdefault((control, member), []).append(int(work[0].group(1)) / int(work[4].group(1)))
+    names = {("adaptive", "birkhoff_gauss6"): "Adaptive gauss6", ("adaptive", "dopri5"): "dopri5",
+             ("adaptive", "birkhoff_gauss8"): "adaptive gauss8", ("reversible", "birkhoff_gauss8"): "reversible gauss8"}
+    assert set(ratios) == set(names), sorted(ratios)
+    met = sum(ratio <= 0.25 for values in ratios.values() for ratio in values)
+    pairs = sum(len(values) for values in ratios.values())
+    assert f"met by {met} of {pairs} (member, scene) pairs" in accuracy, f"tolerance_sweep.md: {met} of {pairs}"
+    for key, name in names.items():
+        stated = re.search(re.escape(name) + r" (\d+) of (\d+) \(median ([0-9.]+)\)", accuracy)
+        assert stated, f"accuracy.md §4.1 no longer states {name}'s count"
+        values = ratios[key]
+        assert (int(stated.group(1)), int(stated.group(2))) == (sum(r <= 0.25 for r in values), len(values)), \
+            f"{name}: accuracy.md says {stated.group(1)} of {stated.group(2)}; tolerance_sweep.md shows " \
+            f"{sum(r <= 0.25 for r in values)} of {len(values)}"
+        assert shown_matches(stated.group(3), statistics.median(values)), \
+            f"{name}: accuracy.md says median {stated.group(3)}; tolerance_sweep.md gives {statistics.median(values):.3f}"
