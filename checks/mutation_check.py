@@ -38,10 +38,13 @@ class Mutation:
         self.path = path          # file, relative to the repository
         self.original = original  # text that must occur exactly once
         self.mutated = mutated    # its replacement
-        self.tests = tests        # [(test target, gtest filter)], or [("pytest:FILE", -k expression)]
+        self.tests = tests        # [(test target, gtest filter)], [("pytest:FILE", -k expression)] or
+                                  # [("doc:TARGET", doc block name)]
 
 
 PYTEST = "pytest:"  # a study-runner test: pytest on the scratch copy's test/python/FILE, selected with -k
+DOC = "doc:"        # the doc test: "doc:TARGET" builds TARGET, then runs the doc block named by the -k expression
+                    # (test_doc_commands.py against the scratch build's devel space)
 
 
 TRAJECTORY = "trajectory_vs_independent_model_test"
@@ -246,6 +249,15 @@ MUTATIONS = [
         [(PYTEST + "test_study_outcomes.py", "own_columns")],
     ),
     Mutation(
+        "cli_ignores_output_rate",
+        "cart_simulate accepts --output-rate but ignores it: the documented whirl command (h = 0.02 s, "
+        "--output-rate 10) is refused for the scene's 100 Hz output",
+        "src/apps/cart_simulate.cpp",
+        'if (option == "--output-rate") scene.output_rate = parse_positive(option, text);',
+        'if (option == "--output-hz") scene.output_rate = parse_positive(option, text);',
+        [(DOC + "cart_simulate", "cli-1-cart_simulate")],
+    ),
+    Mutation(
         "bag_claim_ignores_lock",
         "a recorder takes another running recorder's locked <path>.active for a killed run's file",
         "src/ros/bag_file_claim.cpp",
@@ -306,7 +318,8 @@ def require_scratch_library(build: pathlib.Path, binary: pathlib.Path):
 
 def build_and_run(build: pathlib.Path, tests, log):
     """Builds the targets of `tests` and runs each; returns (built, [failing tests], [passing tests])."""
-    targets = sorted({target for target, _ in tests if not target.startswith(PYTEST)})
+    targets = sorted({target[len(DOC):] if target.startswith(DOC) else target
+                      for target, _ in tests if not target.startswith(PYTEST)})
     status, output = run(["make", "-C", str(build), "-j2", *targets], log=log) if targets else (0, "")
     if status != 0:
         return False, [], []
@@ -317,6 +330,12 @@ def build_and_run(build: pathlib.Path, tests, log):
             status, output = run(["/usr/bin/python3", "-m", "pytest", "-q", "-p", "no:cacheprovider", str(test_file),
                                   "-k", gtest_filter], log=log)
             (failing if status != 0 else passing).append(f"{target} -k '{gtest_filter}'")
+            continue
+        if target.startswith(DOC):
+            test_file = build.parent / "src/birkhoff_cart/test/python/test_doc_commands.py"
+            status, output = run(["env", f"BIRKHOFF_CART_DEVEL={build / 'devel'}", "/usr/bin/python3", "-m", "pytest",
+                                  "-q", "-p", "no:cacheprovider", str(test_file), "-k", gtest_filter], log=log)
+            (failing if status != 0 else passing).append(f"doc block {gtest_filter}")
             continue
         binary = find_binary(build, target)
         require_scratch_library(build, binary)

@@ -1,10 +1,11 @@
 """The results page of a study, from its rows: one code path, whether the rows came from one machine
-or a hundred. The page records the command, the date, the machine, its load and the workers, so
-every number in it says where it came from; the study kind writes its own sections (kinds/*.py:
+or a hundred. The page records the command, the date, the source commit, the machine, its load and
+the workers, so every number in it says where it came from; the study kind writes its own sections (kinds/*.py:
 report) and names the goals its references cannot resolve."""
 import datetime
 import os
 import platform
+import subprocess
 
 from .kinds import module_of
 
@@ -20,6 +21,46 @@ def machine():
     except OSError:
         pass
     return "%s, %d cores, %s" % (model, os.cpu_count(), platform.system())
+
+
+# Files a report run itself writes or moves (the page, its plots, the rows): not "changes" of the source.
+_OUTPUT_SUFFIXES = (".md", ".png", ".jsonl", ".jsonl.old")
+
+
+def source_commit(directory=None):
+    """The commit of the source tree this runner is part of (`git rev-parse HEAD`), with the number of
+    tracked source files changed since, if any (pages, plots and rows do not count); "—" outside a
+    git checkout (an installed runner)."""
+    directory = directory or os.path.dirname(os.path.abspath(__file__))
+    try:
+        head = subprocess.run(["git", "-C", directory, "rev-parse", "HEAD"], stdout=subprocess.PIPE,
+                              stderr=subprocess.DEVNULL, text=True, timeout=30)
+        if head.returncode != 0 or not head.stdout.strip():
+            return "—"
+        status = subprocess.run(["git", "-C", directory, "status", "--porcelain", "--untracked-files=no"],
+                                stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, timeout=30)
+    except (OSError, subprocess.TimeoutExpired):
+        return "—"
+    changed = [line[3:] for line in status.stdout.splitlines() if line[3:] and not line[3:].endswith(_OUTPUT_SUFFIXES)]
+    commit = "`%s`" % head.stdout.strip()
+    return commit + (" with changes to %d source file%s" % (len(changed), "" if len(changed) == 1 else "s")
+                     if changed else "")
+
+
+def stage_evaluation():
+    """How the Birkhoffian collocation members evaluate their stages in the runs of this machine
+    (docs/integrators.md, "Stage evaluation"): BIRKHOFF_CART_STAGE_EVALUATION when set, else
+    "vector" where the CPU has AVX2 and FMA, "scalar" otherwise. The two agree to round-off only,
+    so a page's errors are reproduced bit for bit on its own path."""
+    chosen = os.environ.get("BIRKHOFF_CART_STAGE_EVALUATION", "")
+    if chosen in ("scalar", "vector"):
+        return chosen
+    try:
+        with open("/proc/cpuinfo") as f:
+            flags = next((line.split(":", 1)[1].split() for line in f if line.startswith("flags")), [])
+    except OSError:
+        flags = []
+    return "vector" if "avx2" in flags and "fma" in flags else "scalar"
 
 
 def _cell(text):
@@ -45,7 +86,9 @@ def write_report(study, rows, page_path, command, summary):
            "    %s" % command.replace("\n", " "), "",
            "| | |", "|---|---|",
            "| written | %s |" % datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+           "| source commit | %s |" % source_commit(),
            "| machine | %s |" % _cell(machine()),
+           "| stage evaluation | %s |" % stage_evaluation(),
            "| Dask workers | %s |" % ", ".join(str(w) for w in workers),
            "| load average while running (1 min, over the tasks) | %s |" % (
                "%.1f–%.1f (median %.1f)" % (loads[0], loads[-1], loads[len(loads) // 2]) if loads else "—"),

@@ -52,6 +52,22 @@ CmdVelControllerConfig to_config(const CmdVelControllerSettings& s) {
 
 }  // namespace
 
+const std::vector<std::string>& cmd_vel_controller_parameter_names() {
+  static const std::vector<std::string> names = {
+      "wheel_separation_h", "cmd_vel_timeout", "zero_speed", "steering_joint", "linear/x/max_velocity",
+      "linear/x/min_velocity", "linear/x/has_velocity_limits", "linear/x/max_acceleration", "linear/x/min_acceleration",
+      "linear/x/has_acceleration_limits", "angular/z/max_velocity", "angular/z/has_velocity_limits",
+      "angular/z/max_acceleration", "angular/z/has_acceleration_limits", "steering/max_angle", "steering/max_rate",
+      "steering/max_torque", "steering/p", "steering/d", "drive/max_torque", "drive/ff", "drive/p", "drive/i",
+      "drive/i_clamp",
+      // dynamic_reconfigure's own copies (cfg/CmdVelController.cfg), left on the master by an earlier run
+      "cmd_vel_timeout", "linear_x_max_velocity", "linear_x_min_velocity", "linear_x_max_acceleration",
+      "linear_x_min_acceleration", "angular_z_max_velocity", "angular_z_max_acceleration", "steering_max_angle",
+      "steering_max_rate", "steering_max_torque", "steering_p", "steering_d", "drive_max_torque", "drive_ff", "drive_p",
+      "drive_i", "drive_i_clamp"};
+  return names;
+}
+
 CmdVelControllerSettings load_cmd_vel_controller_settings(const ros::NodeHandle& p) {
   CmdVelControllerSettings s;
   s.wheel_separation_h = read_double_parameter(p, "wheel_separation_h", s.wheel_separation_h);
@@ -105,19 +121,7 @@ CmdVelControllerNode::CmdVelControllerNode(ros::NodeHandle node, ros::NodeHandle
                                          ros::TransportHints().tcpNoDelay());
   joint_state_subscriber_ = node_.subscribe("joint_states", 10, &CmdVelControllerNode::on_joint_states, this,
                                             ros::TransportHints().tcpNoDelay());
-  static const std::vector<std::string> kKnown = {
-      "wheel_separation_h", "cmd_vel_timeout", "zero_speed", "steering_joint", "linear/x/max_velocity",
-      "linear/x/min_velocity", "linear/x/has_velocity_limits", "linear/x/max_acceleration", "linear/x/min_acceleration",
-      "linear/x/has_acceleration_limits", "angular/z/max_velocity", "angular/z/has_velocity_limits",
-      "angular/z/max_acceleration", "angular/z/has_acceleration_limits", "steering/max_angle", "steering/max_rate",
-      "steering/max_torque", "steering/p", "steering/d", "drive/max_torque", "drive/ff", "drive/p", "drive/i",
-      "drive/i_clamp",
-      // dynamic_reconfigure's own copies (cfg/CmdVelController.cfg), left on the master by an earlier run
-      "cmd_vel_timeout", "linear_x_max_velocity", "linear_x_min_velocity", "linear_x_max_acceleration",
-      "linear_x_min_acceleration", "angular_z_max_velocity", "angular_z_max_acceleration", "steering_max_angle",
-      "steering_max_rate", "steering_max_torque", "steering_p", "steering_d", "drive_max_torque", "drive_ff", "drive_p",
-      "drive_i", "drive_i_clamp"};
-  for (const std::string& report : unknown_private_parameters(private_node_, kKnown)) {
+  for (const std::string& report : unknown_private_parameters(private_node_, cmd_vel_controller_parameter_names())) {
     ROS_WARN("cmd_vel_controller: %s", report.c_str());
   }
   reconfigure_server_ =

@@ -1,18 +1,26 @@
 // The list of parameters cart_sim reads (cart_sim_parameter_names(), behind its "did you mean"
 // report of a misspelled parameter) is the list load_parameters() reads: every name it passes to a
 // reader appears in the list and every listed name is read, so a parameter added later is not
-// reported as a typo and a parameter removed is no longer accepted in silence.
+// reported as a typo and a parameter removed is no longer accepted in silence. And the parameter
+// table of docs/ros_interface.md ("### Parameters (all private)" of cart_sim) holds exactly that list:
+// every `~name` of its first column is a name cart_sim reads, and every name it reads has its row
+// (dynamic_reconfigure's copies of the guard limits as the `<quantity>_warn` / `<quantity>_error`
+// of a quantity the `~accuracy/<quantity>` row names). The same for cmd_vel_controller's table and
+// cmd_vel_controller_parameter_names().
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <regex>
 #include <set>
+#include <sstream>
 #include <utility>
 #include <string>
 
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
+#include "birkhoff_cart/ros/cmd_vel_controller_node.h"
 
 namespace birkhoff_cart {
 namespace {
@@ -69,6 +77,60 @@ TEST(CartSimParameterNames, AreExactlyTheNamesLoadParametersReads) {
   }
   for (const std::string& name : read_names) EXPECT_EQ(listed.count(name), 1u) << "~" << name << " is read but not listed";
   for (const std::string& name : listed) EXPECT_EQ(read_names.count(name), 1u) << "~" << name << " is listed but not read";
+}
+
+/// The `~name`s in the first column of the first table after `heading` (searched from `section`) of
+/// docs/ros_interface.md (`~accuracy/<quantity>` gives "accuracy/"), each with its row.
+std::map<std::string, std::string> documented_parameters(const std::string& section, const std::string& heading) {
+  std::ifstream file(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/docs/ros_interface.md");
+  const std::string page((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  const auto at = page.find(heading, page.find(section));
+  if (page.find(section) == std::string::npos || at == std::string::npos) return {};
+  const auto table = page.find("\n|", at);
+  const auto table_end = page.find("\n\n", table);
+  std::istringstream rows(page.substr(table + 1, table_end - table - 1));
+  std::map<std::string, std::string> documented;
+  const std::regex parameter(R"(`~([a-z_0-9/]+)(<quantity>)?`)");
+  for (std::string row; std::getline(rows, row);) {
+    const std::string first = row.substr(0, row.find(" |", 2));
+    for (auto it = std::sregex_iterator(first.begin(), first.end(), parameter); it != std::sregex_iterator(); ++it) {
+      documented[(*it)[1]] = row;
+    }
+  }
+  return documented;
+}
+
+TEST(CartSimParameterNames, AreTheRowsOfTheParameterTableOfRosInterfaceMd) {
+  const auto documented = documented_parameters("## Node `cart_sim`", "### Parameters (all private)");
+  ASSERT_GE(documented.size(), 30u) << "the pattern no longer finds the table's rows";
+  const std::set<std::string> listed(cart_sim_parameter_names().begin(), cart_sim_parameter_names().end());
+  for (const auto& [name, row] : documented) EXPECT_EQ(listed.count(name), 1u) << "~" << name << " is documented but not read";
+  ASSERT_EQ(documented.count("accuracy/"), 1u) << "no row of ~accuracy/<quantity>";
+  const std::string& accuracy_row = documented.at("accuracy/");
+  for (const std::string& name : listed) {
+    if (documented.count(name) != 0) continue;
+    // dynamic_reconfigure's copies: <quantity>_warn, <quantity>_error of a quantity the row names.
+    std::smatch copy;
+    const bool is_copy = std::regex_match(name, copy, std::regex("(.+)_(warn|error)")) &&
+                         accuracy_row.find("`" + copy[1].str() + "`") != std::string::npos;
+    EXPECT_TRUE(is_copy) << "~" << name << " is read by cart_sim but has no row in docs/ros_interface.md";
+  }
+}
+
+TEST(CmdVelControllerParameterNames, AreTheRowsOfItsParameterTableOfRosInterfaceMd) {
+  const auto documented = documented_parameters("## Node `cmd_vel_controller`", "| parameter | unit | default | meaning |");
+  ASSERT_GE(documented.size(), 20u) << "the pattern no longer finds the table's rows";
+  const auto& names = cmd_vel_controller_parameter_names();
+  const std::set<std::string> listed(names.begin(), names.end());
+  for (const auto& [name, row] : documented) EXPECT_EQ(listed.count(name), 1u) << "~" << name << " is documented but not read";
+  for (const std::string& name : listed) {
+    // dynamic_reconfigure's copies spell a documented name with '_' for '/' (linear_x_max_velocity).
+    bool documented_as = documented.count(name) != 0;
+    for (const auto& [documented_name, row] : documented) {
+      documented_as = documented_as || std::regex_replace(documented_name, std::regex("/"), "_") == name;
+    }
+    EXPECT_TRUE(documented_as) << "~" << name << " is read by cmd_vel_controller but has no row in docs/ros_interface.md";
+  }
 }
 
 }  // namespace

@@ -11,10 +11,12 @@
 //               last good one (finite); under the reversible control also a start its pilot runs
 //               cannot integrate, refused when the simulation is built (std::invalid_argument
 //               naming the control);
-// and nothing else (no other exception, no NaN or Inf anywhere). The counts are printed.
-// A fixed seed: the same 1000 cases on every run.
+// and nothing else (no other exception, no NaN or Inf anywhere). The counts are printed, and the
+// table of docs/accuracy.md §3 must be these counts (generated_docs.h: BIRKHOFF_CART_WRITE_DOCS=1
+// rewrites it). A fixed seed: the same 1000 cases on every run.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -22,6 +24,7 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "birkhoff_cart/core/accuracy_guard.h"
@@ -29,6 +32,7 @@
 #include "birkhoff_cart/core/random_scene.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
+#include "generated_docs.h"
 
 namespace birkhoff_cart {
 namespace {
@@ -57,12 +61,24 @@ bool finite_outputs(const Simulation& simulation) {
          (!has_local_error_estimate(statistics) || std::isfinite(statistics.local_error_estimate_last_step));
 }
 
-/// A StepError's cause in a few words, for the printed counts.
+/// How a run stopped, in the words of docs/accuracy.md §3, from its StepError's (or refusal's) message.
 std::string cause_of(const std::string& message) {
-  for (const char* cause : {"Newton", "non-finite", "internal steps", "det M", "singular", "failed"}) {
-    if (message.find(cause) != std::string::npos) return cause;
+  static const std::pair<const char*, const char*> kCauses[] = {
+      {"singular steering angle", "StepError: a step onto the paper case's pole (det M = 0), stopped before it"},
+      {"broke the energy balance", "StepError: a step that blew up: T* beyond its energy balance (a solve on a spurious root, "
+                                   "an explicit member's step far too large)"},
+      {"spurious root", "StepError: the stage solve wandered to a spurious root"},
+      {"Newton", "StepError: the implicit solve (Newton) failed"},
+      {"non-finite", "StepError: a non-finite value, caught before it reached an output"},
+      {"internal steps", "StepError: dopri5's work limit (100 000 internal steps in one simulator step)"},
+      {"fictive step", "StepError: the reversible control's fictive step fell below its floor"},
+      {"needs loads that do not vary in time", "refused when the run is built: the reversible control with loads that vary in time"},
+      {"out of reach", "refused when the run is built: the reversible control's tolerance out of the member's reach"},
+  };
+  for (const auto& [marker, cause] : kCauses) {
+    if (message.find(marker) != std::string::npos) return cause;
   }
-  return "other";
+  return "other: " + message.substr(0, 80);  // a new cause: give it words above
 }
 
 /// Every registered integrator at the scene's fixed step, and two symmetric members under the
@@ -77,6 +93,35 @@ std::vector<std::string> run_variants() {
 struct Tally {
   int ok = 0, warn = 0, guard_error = 0, step_error = 0;
 };
+
+/// The counts as docs/accuracy.md §3 shows them: one row per member (then the reversible variants),
+/// and how the runs that did not end OK or WARN stopped.
+std::string counts_table(const std::map<std::string, Tally>& tallies, const std::map<std::string, int>& guard_quantities,
+                         const std::map<std::string, int>& step_error_causes) {
+  std::string table = "| integrator | OK | WARN | guard ERROR | StepError |\n|---|---|---|---|---|\n";
+  const auto row = [&table](const std::string& label, const Tally& tally) {
+    table += "| " + label + " | " + std::to_string(tally.ok) + " | " + std::to_string(tally.warn) + " | " +
+             std::to_string(tally.guard_error) + " | " + std::to_string(tally.step_error) + " |\n";
+  };
+  for (const std::string& name : integrator_names()) row("`" + name + "`", tallies.at(name));
+  for (const auto& [variant, tally] : tallies) {
+    if (variant.find(" reversible ") == std::string::npos) continue;  // "NAME reversible TOL"
+    row("`" + variant.substr(0, variant.find(' ')) + "`, reversible control, " + variant.substr(variant.rfind(' ') + 1) +
+            " m (every " + std::to_string(kReversibleEvery) + "th scene)",
+        tally);
+  }
+  table += "\n| how the runs that did not end OK or WARN stopped | runs |\n|---|---|\n";
+  for (const auto& [quantity, count] : guard_quantities) {
+    table += "| guard ERROR on `" + quantity + "` | " + std::to_string(count) + " |\n";
+  }
+  std::vector<std::pair<int, std::string>> causes;
+  for (const auto& [cause, count] : step_error_causes) causes.emplace_back(-count, cause);
+  std::sort(causes.begin(), causes.end());
+  for (const auto& [negative_count, cause] : causes) {
+    table += "| " + cause + " | " + std::to_string(-negative_count) + " |\n";
+  }
+  return table;
+}
 
 TEST(RandomHardCases, EveryIntegratorEndsFiniteWithAVerdictOrStopsWithANamedStepError) {
   Scene base = load_scene(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/free_coast.yaml");
@@ -111,7 +156,7 @@ TEST(RandomHardCases, EveryIntegratorEndsFiniteWithAVerdictOrStopsWithANamedStep
                     message.find("step_control 'reversible' needs loads that do not vary in time") != std::string::npos)
             << message;
         ++tallies[integrator].step_error;
-        ++step_error_causes["refused at load: " + cause_of(message)];
+        ++step_error_causes[cause_of(message)];
         continue;
       }
       Simulation& simulation = *built;
@@ -168,8 +213,10 @@ TEST(RandomHardCases, EveryIntegratorEndsFiniteWithAVerdictOrStopsWithANamedStep
         << integrator;
   }
   for (const auto& [quantity, count] : guard_quantities) std::printf("  guard ERROR on %s: %d\n", quantity.c_str(), count);
-  for (const auto& [cause, count] : step_error_causes) std::printf("  StepError %s: %d\n", cause.c_str(), count);
+  for (const auto& [cause, count] : step_error_causes) std::printf("  %s: %d\n", cause.c_str(), count);
   if (!first_step_error.empty()) std::printf("  e.g. %s\n", first_step_error.c_str());
+  EXPECT_TRUE(birkhoff_cart_test::docs_part_is_current("docs/accuracy.md", "random_hard_cases_test",
+                                                       counts_table(tallies, guard_quantities, step_error_causes)));
 }
 
 }  // namespace

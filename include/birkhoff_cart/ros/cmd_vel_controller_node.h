@@ -37,6 +37,12 @@ namespace birkhoff_cart {
 /// naming the first bad one.
 CmdVelControllerSettings load_cmd_vel_controller_settings(const ros::NodeHandle& private_node);
 
+/// Every private parameter the node reads (load_cmd_vel_controller_settings and the node itself),
+/// and dynamic_reconfigure's copies: a private parameter not in the list is reported at start-up
+/// with the closest listed name (a typo). docs/ros_interface.md's table lists the same
+/// (parameter_names_test).
+const std::vector<std::string>& cmd_vel_controller_parameter_names();
+
 class CmdVelControllerNode {
  public:
   /// Throws std::invalid_argument for a bad parameter. `shut_down_on_refusal`: a refusal shuts roscpp
