@@ -220,6 +220,36 @@ def shown_matches(shown, value):
     return abs(float(shown) - value) <= 0.5 * 10.0 ** (exponent - decimals) * (1 + 1e-9)
 
 
+def test_studies_md_quotes_the_whirl_references_of_the_shipped_rows():
+    """docs/studies.md's distances between the whirl's reference and its independent check (1000 s
+    and 10 000 s, by checkpoint) and the check's CPU time are those of the rows results.md is
+    generated from."""
+    from birkhoff_cart_study.references import distances
+    rows = latest_rows(read_rows(str(ROWS)))
+    runs = {(row["type"], row["label"]): row for row in rows if row.get("type") in ("reference", "reference_check")}
+
+    def spread(label):
+        return dict(distances(runs[("reference", label)]["reference_text"],
+                              runs[("reference_check", label)]["reference_text"]))
+
+    whirl_1000, whirl_10000 = spread("whirl_1000s"), spread("whirl_10000s")
+    text = re.sub(r"\s+", " ", (REPO / "docs" / "studies.md").read_text())
+    about = re.search(r"the two agree to about ([0-9.e-]+) m over 1000 s", text)
+    assert about, "docs/studies.md no longer states the 1000 s whirl reference's spread"
+    assert abs(float(about.group(1)) - max(whirl_1000.values())) <= 0.25 * float(about.group(1)), \
+        f"docs/studies.md: about {about.group(1)} m over 1000 s; the rows give {max(whirl_1000.values()):.2g} m"
+    stated = re.search(r"Over 10 000 s they agree to ([0-9.e-]+) m up to 2000 s, then differ by ([0-9.e-]+) m at "
+                       r"5000 s and ([0-9.e-]+) m at 10 000 s", text)
+    assert stated, "docs/studies.md no longer states the 10 000 s whirl reference's spread"
+    up_to_2000 = max(d for t, d in whirl_10000.items() if t <= 2000.0)
+    for shown, value in zip(stated.groups(), (up_to_2000, whirl_10000[5000.0], whirl_10000[10000.0])):
+        assert shown_matches(shown, value), f"docs/studies.md states {shown} m, the rows give {value:.3g} m"
+    cpu = re.search(r"the check took about (\d+) s of CPU", text)
+    check_cpu = runs[("reference_check", "whirl_10000s")]["process_cpu_s"]
+    assert cpu and abs(float(cpu.group(1)) - check_cpu) <= 0.1 * check_cpu, \
+        f"docs/studies.md: the check took {cpu and cpu.group(1)} s; its row: {check_cpu:.0f} s"
+
+
 def test_the_reversible_whirl_table_of_accuracy_md_is_the_shipped_run():
     """docs/accuracy.md §4.2 quotes bench/results/reversible_whirl.csv, the table the command beside
     it wrote, to the digits it shows (the 10 000 s runs take half a minute: the doc test does not
