@@ -106,4 +106,23 @@ inline ::testing::AssertionResult page_bound_holds(const std::string& page, cons
                                        << ": correct the page";
 }
 
+/// `n` as the pages write counts: groups of three digits apart by a space from 10 000 up ("66 667").
+inline std::string count_as_written(long n) {
+  std::string digits = std::to_string(n < 0 ? -n : n);
+  if (digits.size() > 4) {
+    for (int at = static_cast<int>(digits.size()) - 3; at > 0; at -= 3) digits.insert(static_cast<std::size_t>(at), " ");
+  }
+  return (n < 0 ? "-" : "") + digits;
+}
+
+/// The page states `text` (a count with its words, as a test builds it from what it counted),
+/// with any run of white space in the page read as one space (a sentence may wrap).
+inline ::testing::AssertionResult page_states(const std::string& page, const std::string& text) {
+  const std::string raw = read_file(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/" + page);
+  const std::string flat = std::regex_replace(raw, std::regex(R"(\s+)"), " ");
+  if (flat.find(text) != std::string::npos) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << page << " does not state '" << text
+                                       << "' (what the test counts): correct the page";
+}
+
 }  // namespace birkhoff_cart_test
