@@ -50,26 +50,50 @@ inline ::testing::AssertionResult docs_part_is_current(const std::string& page, 
 
 namespace birkhoff_cart_test {
 
-/// The numbers a page states right after `context` (which must occur exactly once in the page), up
-/// to the end of that line: "not reversible (3e-3, 5e-6" after "| `rk2`, `rk4`, `dopri5` | " gives
-/// {3e-3, 5e-6, ...}. Signs (- or −) and exponents are read; a figure written with a thousands space
-/// is not, and "1 + h³" gives 1 (a digit after a non-ASCII character is not read: ³ is no 3).
-inline std::vector<double> figures_after(const std::string& page, const std::string& context) {
-  const std::string text = read_file(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/" + page);
-  const auto at = text.find(context);
-  if (at == std::string::npos || text.find(context, at + 1) != std::string::npos) return {};
-  const auto from = at + context.size();
-  std::string line = text.substr(from, text.find('\n', from) - from);
-  for (std::size_t minus = line.find("−"); minus != std::string::npos; minus = line.find("−", minus)) {
-    line.replace(minus, std::string("−").size(), "-");  // the pages write U+2212 for a negative sign
+/// The numbers of `text` in order. Signs (- or −) and exponents are read; a figure written with a
+/// thousands space is not, a range "3.97–4.00" gives both ends, and "1 + h³" gives 1 (a digit after
+/// a non-ASCII character is not read: ³ is no 3).
+inline std::vector<double> figures_in(std::string text) {
+  for (std::size_t minus = text.find("−"); minus != std::string::npos; minus = text.find("−", minus)) {
+    text.replace(minus, std::string("−").size(), "-");  // the pages write U+2212 for a negative sign
   }
   static const std::regex number(R"([-+]?\d+(\.\d+)?([eE][-+]?\d+)?)");
   std::vector<double> figures;
-  for (auto match = std::sregex_iterator(line.begin(), line.end(), number); match != std::sregex_iterator();
+  for (auto match = std::sregex_iterator(text.begin(), text.end(), number); match != std::sregex_iterator();
        ++match) {
     figures.push_back(std::stod(match->str()));
   }
   return figures;
+}
+
+/// The rest of the line of `page` after `context`, which must occur exactly once in the page (empty
+/// otherwise).
+inline std::string line_after(const std::string& page, const std::string& context) {
+  const std::string text = read_file(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/" + page);
+  const auto at = text.find(context);
+  if (at == std::string::npos || text.find(context, at + 1) != std::string::npos) return "";
+  const auto from = at + context.size();
+  return text.substr(from, text.find('\n', from) - from);
+}
+
+/// The numbers a page states right after `context` (which must occur exactly once in the page), up
+/// to the end of that line: "not reversible (3e-3, 5e-6" after "| `rk2`, `rk4`, `dopri5` | " gives
+/// {3e-3, 5e-6, ...}.
+inline std::vector<double> figures_after(const std::string& page, const std::string& context) {
+  return figures_in(line_after(page, context));
+}
+
+/// In `line`, the figures of the group that names `member` in backticks, written "A–B (`x`, `y`)"
+/// or "A (`x`)": the numbers between the end of the previous group (a ')', ';' or '|') and the
+/// group's '('. Empty when the line does not name the member in a group.
+inline std::vector<double> group_figures(const std::string& line, const std::string& member) {
+  const auto name = line.find("`" + member + "`");
+  if (name == std::string::npos) return {};
+  const auto open = line.rfind('(', name);
+  if (open == std::string::npos) return {};
+  const auto previous = line.find_last_of(");|", open);
+  const auto from = previous == std::string::npos ? 0 : previous + 1;
+  return figures_in(line.substr(from, open - from));
 }
 
 /// The `index`-th figure a page states after `context` (figures_after) agrees with what the test

@@ -22,6 +22,7 @@
 #include "birkhoff_cart/core/integrators/birkhoff_symplectic.h"
 #include "birkhoff_cart/core/integrators/implicit_midpoint.h"
 #include "birkhoff_cart/core/integrators/runge_kutta.h"
+#include "generated_docs.h"
 #include "registry_members.h"
 #include "test_systems.h"
 
@@ -147,7 +148,8 @@ const double kStepSizes[] = {1e-3, 1e-2, 0.1};  // h [s]
 const double kViolationStepSizes[] = {0.1, 0.2};  // h [s]
 
 template <class Stepper>
-void expect_k_symplectic_on_all_systems(const Stepper& stepper, double tolerance = kSymplecticityTolerance) {
+/// Returns the worst defect [-].
+double expect_k_symplectic_on_all_systems(const Stepper& stepper, double tolerance = kSymplecticityTolerance) {
   StepStatistics statistics;
   double worst = 0.0;
   DampedOscillator oscillator;
@@ -195,6 +197,7 @@ void expect_k_symplectic_on_all_systems(const Stepper& stepper, double tolerance
   std::printf("[ measured ] %s: worst K-symplecticity defect %.3e; Newton iterations %llu over %llu rhs evaluations\n",
               Stepper::name(), worst, static_cast<unsigned long long>(statistics.newton_iterations_total),
               static_cast<unsigned long long>(statistics.rhs_evaluations));
+  return worst;
 }
 
 /// The typed suites below run over the Birkhoffian members of the registry (integrator_members.h),
@@ -209,7 +212,12 @@ TYPED_TEST_SUITE(BirkhoffianMember, birkhoff_cart_test::BirkhoffianSteppers, bir
 TYPED_TEST(BirkhoffianMember, PreservesTheStructureOnEverySystem) {
   // A defect ≤ 1e-13 on the Λ = 0 systems: the oscillators with constant, time-dependent and
   // nonlinear charts, and the cart's Birkhoffian part in both forms.
-  expect_k_symplectic_on_all_systems(this->stepper_, kMemberSymplecticityTolerance);
+  const double worst = expect_k_symplectic_on_all_systems(this->stepper_, kMemberSymplecticityTolerance);
+  // docs/integrators.md states the bound every member keeps, in three places.
+  for (const char* context : {"(Mᵀ K M = K by AD to ≤ ", "Every Birkhoffian member passes to ≤ ",
+                              "(`k_symplectic_test`, `BirkhoffianMember`) | every Birkhoffian member ≤ "}) {
+    EXPECT_TRUE(birkhoff_cart_test::page_bound_holds("docs/integrators.md", context, 0, worst)) << TypeParam::name();
+  }
 }
 
 TYPED_TEST(BirkhoffianMember, ForwardThenBackwardStepReturnsToTheStart) {
@@ -224,6 +232,9 @@ TYPED_TEST(BirkhoffianMember, ForwardThenBackwardStepReturnsToTheStart) {
       EXPECT_LE(symmetry_defect(this->stepper_, full_a, zc, 7.0, h), kSymmetryTolerance) << h;
       EXPECT_LE(symmetry_defect(this->stepper_, full_b, zc, 7.0, h), kSymmetryTolerance) << h;
     }
+    // docs/integrators.md's sleigh table states the bound this test asserts.
+    EXPECT_TRUE(birkhoff_cart_test::page_bound_holds(
+        "docs/integrators.md", "(`k_symplectic_test`) | every Birkhoffian member ≤ ", 0, kSymmetryTolerance));
     for (double gamma : {0.0, 1.0}) {  // the sleigh with its blade, both forms
       const ChaplyginSleigh sleigh = sleigh_form(gamma, true);
       EXPECT_LE(symmetry_defect(this->stepper_, sleigh, sleigh.state(0.2, 0.4, -0.5, 1.7), 0.8, h), kSymmetryTolerance)
@@ -284,6 +295,10 @@ TEST(KSymplecticity, TheSleighsPaperFormSeparatesBirkhoffFromRk4AndMidpointInZ) 
     EXPECT_LE(birkhoff2, kMemberSymplecticityTolerance) << "h = " << h;
     EXPECT_GE(rk4, kViolationFactor * kSymplecticityTolerance) << "h = " << h;
     EXPECT_GE(midpoint, kViolationFactor * kSymplecticityTolerance) << "h = " << h;
+    if (h == 0.1) {  // docs/integrators.md's sleigh table quotes them (one digit)
+      EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/integrators.md", "on the eᵗ form rk4 ", 0, rk4, 0.25));
+      EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/integrators.md", "on the eᵗ form rk4 ", 1, midpoint, 0.25));
+    }
   }
 }
 
