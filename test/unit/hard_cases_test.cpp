@@ -23,6 +23,7 @@
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
 #include "birkhoff_cart/core/singular_steering.h"
+#include "generated_docs.h"
 #include "test_scenes.h"
 
 namespace birkhoff_cart {
@@ -298,6 +299,31 @@ TEST_P(Jackknife, ThroughQuarterAndWholeTurnsWithInvariantsKept) {
 INSTANTIATE_TEST_SUITE_P(EveryMethod, Jackknife,
                          ::testing::ValuesIn(free_cases({"near_jackknife", "jackknife_whirl"})), free_label);
 
+/// A figure of a generated table: two digits, or "< 1e-11" where it is round-off (its digits differ
+/// between the stage-evaluation paths and CPUs).
+std::string table_figure(double value) {
+  if (value < 1e-11) return "< 1e-11";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.2g", value);
+  return text;
+}
+
+// docs/hard_cases.md §2's table is generated from these runs (generated_docs.h): the whirl of the
+// test above, for every member in both forms.
+TEST(Jackknife, TheWhirlTableOfTheDocsIsTheRunOfEveryMember) {
+  std::string table = "| member (form) | whirl max \\|ΔT*\\|/T*₀ | whirl max \\|Δp2\\| [kg·m²/s] |\n|---|---|---|\n";
+  for (const Method& method : every_method()) {
+    Scene scene = with_method(shipped("jackknife_whirl"), method);
+    scene.duration = kWhirlDuration;
+    const RunOutcome outcome = run(scene);
+    ASSERT_FALSE(outcome.stopped) << method.integrator << ": " << outcome.error;
+    table += "| `" + method.integrator + "` (" + to_string(method.form) + ") | " +
+             table_figure(outcome.max_energy_residual / outcome.initial_energy) + " | " +
+             table_figure(outcome.max_p2_residual) + " |\n";
+  }
+  EXPECT_TRUE(birkhoff_cart_test::docs_part_is_current("docs/hard_cases.md", "hard_cases_test §2", table));
+}
+
 class ReverseDriving : public ::testing::TestWithParam<FreeCase> {};
 
 TEST_P(ReverseDriving, InvariantsKeptWhileTheStateDiverges) {
@@ -315,7 +341,18 @@ TEST_P(ReverseDriving, InvariantsKeptWhileTheStateDiverges) {
     neighbour.step();
     separation = std::max(separation, std::abs(nominal.state().steering_angle - neighbour.state().steering_angle));
   }
-  expect_free_invariants(run(scene), label);
+  const RunOutcome outcome = run(scene);
+  expect_free_invariants(outcome, label);
+  // docs/hard_cases.md §3 states the bounds every member keeps here.
+  const std::string page = "docs/hard_cases.md";
+  EXPECT_TRUE(birkhoff_cart_test::page_bound_holds(page, "The test checks the\ninvariants, not the state: energy ≤ ", 0,
+                                                   outcome.max_energy_residual / outcome.initial_energy)) << label;
+  EXPECT_TRUE(birkhoff_cart_test::page_bound_holds(page, "(birkhoff2 paper) and ≤ ", 0,
+                                                   label == "reverse_jackknife/birkhoff2/paper" ? 0.0 : outcome.max_p2_residual))
+      << label;
+  if (label == "reverse_jackknife/birkhoff2/paper") {
+    EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, "1e-10), p2 ≤ ", 0, outcome.max_p2_residual, 0.06));
+  }
   // The reversing cart leaves the straight line χ = 0 and folds up (the state diverges from it) ...
   EXPECT_GT(std::abs(nominal.state().steering_angle), kReverseFoldAngle) << label;
   // ... and a 1e-9 rad/s change of ω2 grows by orders of magnitude on the way: no comparison with
@@ -354,9 +391,12 @@ bool stays_bounded(const RunOutcome& outcome, double initial_mechanical_energy) 
 
 TEST(StiffHinge, ExplicitMethodsBreakAtOneMillisecondImplicitSymmetricOnesStayBounded) {
   const std::vector<double> steps = {1e-4, 2e-4, 5e-4, 1e-3, 2e-3, 5e-3, 1e-2, 2e-2};  // h [s]
+  // docs/hard_cases.md §4's table is generated from these runs (generated_docs.h).
+  std::string table = "| member | bounded at 1 ms | first breakdown |\n|---|---|---|\n";
   for (const std::string& integrator : integrator_names()) {
     bool stable_at_millisecond = false;
     std::string breakdown = "none";
+    std::string first_breakdown = "none up to " + std::to_string(static_cast<int>(std::lround(steps.back() * 1e3))) + " ms";
     for (double h : steps) {
       const Scene scene = stiff_hinge(integrator, h);
       const double chi0 = scene.initial_state.steering_angle;
@@ -375,11 +415,14 @@ TEST(StiffHinge, ExplicitMethodsBreakAtOneMillisecondImplicitSymmetricOnesStayBo
                       outcome.stopped ? "StepError" : "energy grew x" /* see factor below */);
         breakdown = text;
         if (!outcome.stopped) breakdown += std::to_string(outcome.max_mechanical_energy / initial);
+        std::snprintf(text, sizeof text, "%g ms (%s)", h * 1e3, outcome.stopped ? "StepError" : "energy grew");
+        first_breakdown = text;
       }
     }
     std::printf("[ measured ] stiff hinge (k_s = %.0e N m/rad, b = %.0e N m s/rad) %s: stable at 1 ms: %s, first breakdown: %s\n",
                 kStiffStiffness, kStiffDamping, integrator.c_str(), stable_at_millisecond ? "yes" : "no",
                 breakdown.c_str());
+    table += "| `" + integrator + "` | " + (stable_at_millisecond ? "yes" : "no") + " | " + first_breakdown + " |\n";
     if (integrator == "rk2" || integrator == "rk4") {
       EXPECT_FALSE(stable_at_millisecond) << integrator << " is not broken by this hinge: not stiff enough";
     }
@@ -387,6 +430,7 @@ TEST(StiffHinge, ExplicitMethodsBreakAtOneMillisecondImplicitSymmetricOnesStayBo
       EXPECT_TRUE(stable_at_millisecond) << integrator;
     }
   }
+  EXPECT_TRUE(birkhoff_cart_test::docs_part_is_current("docs/hard_cases.md", "hard_cases_test §4", table));
 }
 
 // ---------------------------------------------------------------------------------------------
