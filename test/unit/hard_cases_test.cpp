@@ -544,6 +544,18 @@ TEST(ExtremeParameters, EveryExtremeCartRunsWithItsInvariantsKept) {
         std::printf("[ measured ] extreme %s: %s, max |dT*|/T*0 = %.3g, chi in [%.3g, %.3g] rad\n", label.c_str(),
                     outcome.stopped ? outcome.error.c_str() : "ran", outcome.max_energy_residual / outcome.initial_energy,
                     outcome.min_steering_angle, outcome.max_steering_angle);
+        // docs/hard_cases.md §6 states the energy drift of these runs.
+        const double drift = outcome.max_energy_residual / outcome.initial_energy;
+        const std::string page = "docs/hard_cases.md";
+        if (cart.step_size == 1e-5) {
+          EXPECT_TRUE(birkhoff_cart_test::page_bound_holds(page, "all three keep energy to ", 0, drift)) << label;
+        } else if (std::string(integrator) == "rk4") {
+          EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, "identical dimensionless\nbehaviour, energy drift ", 2, drift, 0.06))
+              << label;
+        } else {
+          EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, "identical dimensionless\nbehaviour, energy drift ", 0, drift, 0.06))
+              << label;
+        }
       } catch (const std::invalid_argument& error) {
         ADD_FAILURE() << label << " refused at construction: " << error.what();
       }
