@@ -50,12 +50,30 @@ inline ::testing::AssertionResult docs_part_is_current(const std::string& page, 
 
 namespace birkhoff_cart_test {
 
-/// The numbers of `text` in order. Signs (- or −) and exponents are read; a figure written with a
+/// The numbers of `text` in order. Signs (- or −) and exponents ("e-15", "·10⁻¹⁵") are read; a figure written with a
 /// thousands space is not, a range "3.97–4.00" gives both ends, and "1 + h³" gives 1 (a digit after
 /// a non-ASCII character is not read: ³ is no 3).
 inline std::vector<double> figures_in(std::string text) {
   for (std::size_t minus = text.find("−"); minus != std::string::npos; minus = text.find("−", minus)) {
     text.replace(minus, std::string("−").size(), "-");  // the pages write U+2212 for a negative sign
+  }
+  // "4·10⁻¹⁵" (derivation.md's notation) is read as 4e-15.
+  static const char* const kSuperscripts[] = {"⁰", "¹", "²", "³", "⁴", "⁵", "⁶", "⁷", "⁸", "⁹"};
+  for (std::size_t at = text.find("·10⁻"); at != std::string::npos; at = text.find("·10⁻", at)) {
+    std::string exponent;
+    std::size_t end = at + std::string("·10⁻").size();
+    for (bool more = true; more;) {
+      more = false;
+      for (int digit = 0; digit < 10; ++digit) {
+        const std::string superscript = kSuperscripts[digit];
+        if (text.compare(end, superscript.size(), superscript) == 0) {
+          exponent += static_cast<char>('0' + digit);
+          end += superscript.size();
+          more = true;
+        }
+      }
+    }
+    text.replace(at, end - at, exponent.empty() ? " " : "e-" + exponent);
   }
   static const std::regex number(R"([-+]?\d+(\.\d+)?([eE][-+]?\d+)?)");
   std::vector<double> figures;
