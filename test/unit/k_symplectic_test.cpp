@@ -218,6 +218,8 @@ TYPED_TEST(BirkhoffianMember, PreservesTheStructureOnEverySystem) {
                               "(`k_symplectic_test`, `BirkhoffianMember`) | every Birkhoffian member ≤ "}) {
     EXPECT_TRUE(birkhoff_cart_test::page_bound_holds("docs/integrators.md", context, 0, worst)) << TypeParam::name();
   }
+  EXPECT_TRUE(birkhoff_cart_test::page_bound_holds("docs/birkhoffian.md", "worst K-symplecticity defect ≤ ", 0, worst))
+      << TypeParam::name();
 }
 
 TYPED_TEST(BirkhoffianMember, ForwardThenBackwardStepReturnsToTheStart) {
@@ -254,6 +256,9 @@ TEST(KSymplecticity, ClassicalRungeKutta4ViolatesIt) {
     std::printf("[ measured ] rk4 h = %g: damped oscillator %.3e, cubic chart %.3e\n", h, d1, d2);
     EXPECT_GE(d1, kViolationFactor * kSymplecticityTolerance) << "h = " << h;
     EXPECT_GE(d2, kViolationFactor * kSymplecticityTolerance) << "h = " << h;
+    // docs/birkhoffian.md §7 quotes the damped oscillator's defects at h = 0.1 and 0.2 (figures 0, 2).
+    EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/birkhoffian.md", "On the damped oscillator rk4 misses by ",
+                                                       h == 0.1 ? 0 : 2, d1, 0.06)) << "h = " << h;
   }
 }
 
@@ -272,6 +277,13 @@ TEST(KSymplecticity, NonlinearTimeDependentChartSeparatesBirkhoffFromRk4AndMidpo
     const double midpoint = symplecticity_defect(ImplicitMidpoint{}, system, z, 0.4, h, statistics);
     std::printf("[ measured ] cubic damped chart h = %g: birkhoff2 %.3e, birkhoff4 %.3e, rk4 %.3e, midpoint in z %.3e\n",
                 h, birkhoff2, birkhoff4, rk4, midpoint);
+    if (h == 0.1) {  // docs/birkhoffian.md §7 quotes them: figures 0, 2, 4, 5 ("birkhoff4" and "rk4" give a 4 each)
+      const char context[] = "On the cubic damped chart (B.22) at h = 0.1, the defects are birkhoff2 ";
+      EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/birkhoffian.md", context, 0, birkhoff2, 0.06));
+      EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/birkhoffian.md", context, 2, birkhoff4, 0.06));
+      EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/birkhoffian.md", context, 4, rk4, 0.06));
+      EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/birkhoffian.md", context, 5, midpoint, 0.06));
+    }
     EXPECT_LE(birkhoff2, kSymplecticityTolerance) << "h = " << h;
     EXPECT_LE(birkhoff4, kSymplecticityTolerance) << "h = " << h;
     EXPECT_GE(rk4, kViolationFactor * kSymplecticityTolerance) << "h = " << h;
@@ -321,6 +333,12 @@ TEST(KSymplecticity, Birkhoff2InTheWrongChartViolatesIt) {
                 d1, d2);
     EXPECT_GE(d1, kViolationFactor * kSymplecticityTolerance) << "h = " << h;
     EXPECT_GE(d2, kViolationFactor * kSymplecticityTolerance) << "h = " << h;
+    if (h == 0.1) {  // docs/birkhoffian.md §7 quotes the three defects at h = 0.1
+      const char context[] = "birkhoff2 in the identity chart by ";
+      EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/birkhoffian.md", context, 0, d1, 0.06));
+      EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/birkhoffian.md", context, 1, d2, 0.06));
+      EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/birkhoffian.md", context, 2, d3, 0.06));
+    }
   }
 }
 
