@@ -74,6 +74,15 @@ using birkhoff_cart_test::scene_path;
 
 Scene shipped(const std::string& name) { return load_scene(scene_path(name)); }
 
+/// A figure of a generated table: two digits, or "< 1e-11" where it is round-off (its digits differ
+/// between the stage-evaluation paths and CPUs).
+std::string table_figure(double value) {
+  if (value < 1e-11) return "< 1e-11";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.2g", value);
+  return text;
+}
+
 /// Every field finite (time, coordinates, quasi-velocities, balances).
 bool all_finite(const CartState& state) {
   bool finite = std::isfinite(state.time) && std::isfinite(state.x) && std::isfinite(state.y) &&
@@ -171,10 +180,21 @@ RunOutcome run(const Scene& scene, double stiffness = 0.0 /* k_s [N·m/rad] */) 
 
 class PaperSingularity : public ::testing::TestWithParam<Method> {};
 
-TEST_P(PaperSingularity, StopsBeforeThePoleNamingTheSingularTime) {
-  Scene scene = with_method(shipped("paper_special"), GetParam());
-  scene.duration = 2.0;  // t₀ = π/2 → 3.57 s: past the pole at t = π
+/// The paper's special case run with `method` from t₀ = π/2 towards 3.57 s, past the pole at t = π.
+Scene past_the_pole(const Method& method) {
+  Scene scene = with_method(shipped("paper_special"), method);
+  scene.duration = 2.0;  // [s]
   scene.reference.kind = ReferenceSettings::Kind::kNone;
+  return scene;
+}
+
+/// |ω1 sin χ − 1| of a state (the exact solution has ω1 sin χ = 1) [-].
+double pole_invariant_error(const CartState& state) {
+  return std::abs(state.forward_speed * std::sin(state.steering_angle) - 1.0);
+}
+
+TEST_P(PaperSingularity, StopsBeforeThePoleNamingTheSingularTime) {
+  const Scene scene = past_the_pole(GetParam());
   const RunOutcome outcome = run(scene);
   const double h = scene.integrator.step_size;
   ASSERT_TRUE(outcome.stopped) << "ran across the pole to t = " << outcome.last.time
@@ -195,6 +215,21 @@ TEST_P(PaperSingularity, StopsBeforeThePoleNamingTheSingularTime) {
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryMethod, PaperSingularity, ::testing::ValuesIn(every_method()), method_label);
+
+// docs/hard_cases.md §1's table is generated from these runs (generated_docs.h).
+TEST(PaperSingularity, TheTableOfTheDocsIsTheStopOfEveryMember) {
+  std::string table = "| member | \\|ω1 sin χ − 1\\| at the stop, autonomous | paper form |\n|---|---|---|\n";
+  for (const std::string& integrator : integrator_names()) {
+    table += "| `" + integrator + "` |";
+    for (BirkhoffianForm form : {BirkhoffianForm::kAutonomous, BirkhoffianForm::kPaper}) {
+      const RunOutcome outcome = run(past_the_pole(Method{integrator, form}));
+      ASSERT_TRUE(outcome.stopped) << integrator << "/" << to_string(form);
+      table += " " + table_figure(pole_invariant_error(outcome.last)) + " |";
+    }
+    table += "\n";
+  }
+  EXPECT_TRUE(birkhoff_cart_test::docs_part_is_current("docs/hard_cases.md", "hard_cases_test §1", table));
+}
 
 TEST(PaperSingularity, RetryingTheRefusedStepLosesNothing) {
   Scene scene = shipped("paper_special");
@@ -298,15 +333,6 @@ TEST_P(Jackknife, ThroughQuarterAndWholeTurnsWithInvariantsKept) {
 
 INSTANTIATE_TEST_SUITE_P(EveryMethod, Jackknife,
                          ::testing::ValuesIn(free_cases({"near_jackknife", "jackknife_whirl"})), free_label);
-
-/// A figure of a generated table: two digits, or "< 1e-11" where it is round-off (its digits differ
-/// between the stage-evaluation paths and CPUs).
-std::string table_figure(double value) {
-  if (value < 1e-11) return "< 1e-11";
-  char text[32];
-  std::snprintf(text, sizeof text, "%.2g", value);
-  return text;
-}
 
 // docs/hard_cases.md §2's table is generated from these runs (generated_docs.h): the whirl of the
 // test above, for every member in both forms.
