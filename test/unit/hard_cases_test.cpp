@@ -321,13 +321,18 @@ TEST_P(Jackknife, ThroughQuarterAndWholeTurnsWithInvariantsKept) {
   const RunOutcome outcome = run(scene);
   const std::string label = c.scene + "/" + c.method.integrator + "/" + to_string(c.method.form);
   expect_free_invariants(outcome, label);
+  const std::string page = "docs/hard_cases.md";  // §2 states the angles every member reaches
   if (whirl) {
     // χ passes the jackknife angle π/2 (cos χ = 0) and goes on through whole turns, unwrapped.
     EXPECT_LT(outcome.min_steering_angle, M_PI / 2.0) << label;
     EXPECT_GT(outcome.max_steering_angle - outcome.min_steering_angle, kWhirlMinimumTurns * 2.0 * M_PI) << label;
+    EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, "passes π/2 and turns χ from 1.2 to ", 0,
+                                                       outcome.max_steering_angle, 1.5e-4)) << label;
   } else {
     // The near jackknife creeps up to π/2 without folding.
     EXPECT_GT(outcome.max_steering_angle, M_PI / 2.0 - kNearJackknifeApproach) << label;
+    EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, "`near_jackknife` (6 s) creeps to χ = ", 0,
+                                                       outcome.max_steering_angle, 4e-4)) << label;
   }
 }
 
@@ -387,6 +392,9 @@ TEST_P(ReverseDriving, InvariantsKeptWhileTheStateDiverges) {
   EXPECT_GT(growth, kReverseMinimumGrowth) << label;
   std::printf("[ measured ] %s: final chi %.6f rad, a %.0e rad/s change of omega2 grows x%.3g\n", label.c_str(),
               nominal.state().steering_angle, kReversePerturbation, growth);
+  EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, "χ runs from 0 to ", 0, nominal.state().steering_angle, 2e-4))
+      << label;
+  EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, "largest |Δχ| over the run is ", 0, growth, 2e-3)) << label;
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryMethod, ReverseDriving, ::testing::ValuesIn(free_cases({"reverse_jackknife"})),
