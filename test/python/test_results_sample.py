@@ -220,6 +220,89 @@ def shown_matches(shown, value):
     return abs(float(shown) - value) <= 0.5 * 10.0 ** (exponent - decimals) * (1 + 1e-9)
 
 
+def test_studies_md_quotes_the_whirl_references_of_the_shipped_rows():
+    """docs/studies.md's distances between the whirl's reference and its independent check (1000 s
+    and 10 000 s, by checkpoint) and the check's CPU time are those of the rows results.md is
+    generated from."""
+    from birkhoff_cart_study.references import distances
+    rows = latest_rows(read_rows(str(ROWS)))
+    runs = {(row["type"], row["label"]): row for row in rows if row.get("type") in ("reference", "reference_check")}
+
+    def spread(label):
+        return dict(distances(runs[("reference", label)]["reference_text"],
+                              runs[("reference_check", label)]["reference_text"]))
+
+    whirl_1000, whirl_10000 = spread("whirl_1000s"), spread("whirl_10000s")
+    text = re.sub(r"\s+", " ", (REPO / "docs" / "studies.md").read_text())
+    about = re.search(r"the two agree to about ([0-9.e-]+) m over 1000 s", text)
+    assert about, "docs/studies.md no longer states the 1000 s whirl reference's spread"
+    assert abs(float(about.group(1)) - max(whirl_1000.values())) <= 0.25 * float(about.group(1)), \
+        f"docs/studies.md: about {about.group(1)} m over 1000 s; the rows give {max(whirl_1000.values()):.2g} m"
+    stated = re.search(r"Over 10 000 s they agree to ([0-9.e-]+) m up to 2000 s, then differ by ([0-9.e-]+) m at "
+                       r"5000 s and ([0-9.e-]+) m at 10 000 s", text)
+    assert stated, "docs/studies.md no longer states the 10 000 s whirl reference's spread"
+    up_to_2000 = max(d for t, d in whirl_10000.items() if t <= 2000.0)
+    for shown, value in zip(stated.groups(), (up_to_2000, whirl_10000[5000.0], whirl_10000[10000.0])):
+        assert shown_matches(shown, value), f"docs/studies.md states {shown} m, the rows give {value:.3g} m"
+    cpu = re.search(r"the check took about (\d+) s of CPU", text)
+    check_cpu = runs[("reference_check", "whirl_10000s")]["process_cpu_s"]
+    assert cpu and abs(float(cpu.group(1)) - check_cpu) <= 0.1 * check_cpu, \
+        f"docs/studies.md: the check took {cpu and cpu.group(1)} s; its row: {check_cpu:.0f} s"
+
+
+def shown_count_matches(shown, value):
+    """A count as a page shows it ("321 700", "831") is `value` rounded to its last non-zero digit."""
+    digits = shown.replace(" ", "")
+    unit = 10 ** (len(digits) - len(digits.rstrip("0"))) if digits.strip("0") else 1
+    return abs(int(digits) - value) <= unit / 2
+
+
+# docs/benchmarks.md, "Where the peers still win": what it quotes from the shipped rows, as
+# (pattern, [(experiment, method, step or tolerance, what of the row) per group]).
+PEERS_STILL_WIN = [
+    (r"birkhoff_gauss8 under it needs ([\d ]+) evaluations for 1e-6 m over 1000 s against ([\d ]+) at the best fixed step",
+     [("jackknife_whirl_1000s", "birkhoff_gauss8_reversible", 1e-6, "rhs"), ("jackknife_whirl_1000s", "birkhoff_gauss8", 0.04, "rhs")]),
+    (r"bulirsch_stoer needs ([\d ]+) and costs less per evaluation \((\d+) against (\d+) ns\)",
+     [("jackknife_whirl_1000s", "odeint_bulirsch_stoer", 1e-12, "rhs"), ("jackknife_whirl_1000s", "odeint_bulirsch_stoer", 1e-12, "ns"),
+      ("jackknife_whirl_1000s", "birkhoff_gauss8_reversible", 1e-6, "ns")]),
+    (r"also delivers ([0-9.e-]+) m at a tolerance of 1e-6 m, and ([0-9.e-]+) m at 1e-5 m",
+     [("jackknife_whirl_1000s", "birkhoff_gauss8_reversible", 1e-6, "error"), ("jackknife_whirl_1000s", "birkhoff_gauss8_reversible", 1e-5, "error")]),
+    (r"gauss8 adaptive ([\d ]+) evaluations in ([\d ]+) steps \(([0-9.]+) µs each, ([0-9.]+) ms\)",
+     [("drive_rr_drag", "birkhoff_gauss8_adaptive", 3e-6, k) for k in ("rhs", "steps", "µs", "ms")]),
+    (r"our dopri5 ([\d ]+) evaluations in ([\d ]+) steps \(([0-9.]+) µs each, ([0-9.]+) ms\)",
+     [("drive_rr_drag", "dopri5", 1e-8, k) for k in ("rhs", "steps", "µs", "ms")]),
+    (r"\(rkf78: ([\d ]+) evaluations, gauss8 adaptive ([\d ]+);",
+     [("very_stiff_hinge", "odeint_rkf78", 1e-6, "rhs"), ("very_stiff_hinge", "birkhoff_gauss8_adaptive", 0.1, "rhs")]),
+    (r"\(([\d ]+) for gauss8 adaptive at 1e-8 m, which ends ([0-9.e-]+) m off; ([\d ]+) at 1e-9 m; rkf78 ([\d ]+)\)",
+     [("very_stiff_hinge", "birkhoff_gauss8_adaptive", 1e-8, "rhs"), ("very_stiff_hinge", "birkhoff_gauss8_adaptive", 1e-8, "error"),
+      ("very_stiff_hinge", "birkhoff_gauss8_adaptive", 1e-9, "rhs"), ("very_stiff_hinge", "odeint_rkf78", 1e-11, "rhs")]),
+]
+
+
+def test_the_benchmark_page_quotes_the_shipped_rows():
+    """docs/benchmarks.md's explanation of where the peers still win quotes evaluation counts,
+    steps, errors and (from the same rows) CPU times per evaluation; they are the shipped rows'."""
+    measured = [row for row in latest_rows(read_rows(str(ROWS))) if row.get("type") == "measure"]
+
+    def row_of(label, method, setting):
+        found = [row for row in measured if row["label"] == label and row["method"] == method
+                 and setting in (row.get("step"), row.get("tolerance"))]
+        assert len(found) == 1, f"the rows have {len(found)} runs {label} {method} {setting:g}"
+        return found[0]["result"]
+
+    text = re.sub(r"\s+", " ", (REPO / "docs" / "benchmarks.md").read_text())
+    for pattern, quoted in PEERS_STILL_WIN:
+        match = re.search(pattern, text)
+        assert match, f"docs/benchmarks.md no longer says /{pattern}/"
+        for shown, (label, method, setting, what) in zip(match.groups(), quoted):
+            result = row_of(label, method, setting)
+            value = {"rhs": result["rhs_evaluations"], "steps": result["steps"], "error": result["position_error_m"],
+                     "ns": 1e9 * result["cpu_median_s"] / result["rhs_evaluations"],
+                     "µs": 1e6 * result["cpu_median_s"] / result["rhs_evaluations"], "ms": 1e3 * result["cpu_median_s"]}[what]
+            ok = shown_count_matches(shown, value) if what in ("rhs", "steps") else shown_matches(shown, value)
+            assert ok, f"docs/benchmarks.md: {shown} ({what} of {label} {method} {setting:g}); the shipped row: {value:.4g}"
+
+
 def test_the_reversible_whirl_table_of_accuracy_md_is_the_shipped_run():
     """docs/accuracy.md §4.2 quotes bench/results/reversible_whirl.csv, the table the command beside
     it wrote, to the digits it shows (the 10 000 s runs take half a minute: the doc test does not

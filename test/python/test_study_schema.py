@@ -225,3 +225,13 @@ def test_a_file_over_the_size_cap_is_refused_unparsed(study_file, registry):
 def test_every_case_names_a_different_problem():
     assert len(MALFORMED) >= 30
     assert len({what for what, _, _ in MALFORMED}) == len(MALFORMED)
+
+
+def test_the_pages_count_the_malformed_cases():
+    """docs/studies.md and docs/developing.md state how many malformed study files are refused."""
+    import pathlib
+    import re
+    docs = pathlib.Path(__file__).resolve().parents[2] / "docs"
+    for page, words in (("studies.md", "malformed study files"), ("developing.md", "malformed files")):
+        text = re.sub(r"\s+", " ", (docs / page).read_text())
+        assert f"{len(MALFORMED)} {words}" in text, f"docs/{page} does not state '{len(MALFORMED)} {words}'"

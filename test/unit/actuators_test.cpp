@@ -18,6 +18,7 @@
 #include "birkhoff_cart/core/run_summary.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
+#include "generated_docs.h"
 
 namespace birkhoff_cart {
 namespace {
@@ -172,6 +173,14 @@ TEST(ActuatedCart, KeepsTheOrderOfTheMethod) {
   EXPECT_GT(order_coarse, 3.6) << coarse << " " << middle;
   EXPECT_GT(order_fine, 3.6) << middle << " " << fine;
   EXPECT_GT(coarse, 1e-9);  // the errors are above round-off, so the orders mean something
+  // docs/actuators.md §2 quotes the errors (two digits) and the orders (to 0.01).
+  const std::string page = "docs/actuators.md";
+  const std::string row = "| position error after 4 s [m] | ";
+  EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, row, 0, coarse, 0.06));
+  EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, row, 1, middle, 0.06));
+  EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, row, 2, fine, 0.06));
+  EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, "Observed orders ", 0, order_coarse, 0.0015));
+  EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, "Observed orders ", 1, order_fine, 0.0015));
 }
 
 TEST(ActuatedCart, TheCartReceivesTheActuatorsTorque) {

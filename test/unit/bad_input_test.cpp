@@ -4,7 +4,7 @@
 //    state untouched; a flood of 1e5 commands (10 kHz for 10 s of 1 kHz steps) keeps memory flat and
 //    the latest valid command wins at every step;
 //  - the batch CLI cart_simulate (found next to this test binary in devel/lib/birkhoff_cart/) exits
-//    3 with one line "cart_simulate: scene FILE: key 'KEY': ..." for each of 18 malformed scene
+//    3 with one line "cart_simulate: scene FILE: key 'KEY': ..." for each of 20 malformed scene
 //    files, 2 for bad options, 3 for an unwritable output, 4 with the rows kept when a step fails.
 #include <gtest/gtest.h>
 
@@ -25,6 +25,7 @@
 #include "birkhoff_cart/core/integrators/cart_stepper.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
+#include "generated_docs.h"
 #include "test_scenes.h"
 
 namespace birkhoff_cart {
@@ -140,6 +141,8 @@ TEST(BadCommands, AFloodOfCommandsKeepsMemoryFlatAndTheLatestValidOneWins) {
   EXPECT_NEAR(simulation.state().time, kFloodSteps * 1e-3, 1e-9);
   std::printf("[ measured ] flood: %ld accepted, %ld refused, RSS %ld kB -> %ld kB\n", accepted, refused,
               resident_before, resident_after);
+  EXPECT_TRUE(birkhoff_cart_test::page_states("docs/hard_cases.md", birkhoff_cart_test::count_as_written(accepted) + " accepted, " +
+                                                                      birkhoff_cart_test::count_as_written(refused) + " refused"));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -209,6 +212,7 @@ TEST_F(Cli, EveryMalformedSceneExitsThreeWithOneLineNamingFileAndKey) {
       {"empty_file", "", "(document)"},
   };
   ASSERT_GE(cases.size(), 15u);
+  EXPECT_TRUE(birkhoff_cart_test::page_states("docs/hard_cases.md", "on " + std::to_string(cases.size()) + " malformed files"));
   for (const MalformedScene& malformed : cases) {
     const std::string path = write(malformed.label, malformed.text);
     const CliOutcome result = run_cli("--scene '" + path + "' --output '" + output() + "'", directory_);

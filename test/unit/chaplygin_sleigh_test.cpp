@@ -17,6 +17,7 @@
 #include "birkhoff_cart/core/autodiff.h"
 #include "birkhoff_cart/core/examples/chaplygin_sleigh.h"
 #include "birkhoff_cart/core/integrators/gauss_collocation.h"
+#include "generated_docs.h"
 #include "structure_checks.h"
 
 namespace birkhoff_cart {
@@ -205,6 +206,8 @@ TEST(ChaplyginSleigh, CarriedStepsFollowTheSameTrajectory) {
               static_cast<unsigned long long>(carried_statistics.rhs_evaluations),
               static_cast<unsigned long long>(fresh_statistics.rhs_evaluations));
   EXPECT_LE(difference, 1e-12 * std::max(1.0, z.cwiseAbs().maxCoeff()));
+  EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/integrators.md",
+                                                     "on the sleigh it gives the same trajectory to ", 0, difference, 0.25));
 }
 
 TEST(ChaplyginSleigh, AMemberRunReachesTheKnownAsymptotics) {
@@ -227,6 +230,14 @@ TEST(ChaplyginSleigh, AMemberRunReachesTheKnownAsymptotics) {
   EXPECT_NEAR(motion.remaining_turn(), 0.5 * kPi * motion.peak_turning_rate() / motion.decay_rate(), 1e-14);
   EXPECT_NEAR(z(kSleighHeading), motion.remaining_turn(), 1e-6);
   EXPECT_LE(std::abs(z(kSleighAngularMomentum)), 1e-9);
+  // docs/integrators.md quotes this run: in the example's comment and in the sleigh table.
+  const std::string page = "docs/integrators.md";
+  const std::vector<double> stated_speed = birkhoff_cart_test::figures_after(page, "// 60 s later: v = p1/m = ");
+  ASSERT_FALSE(stated_speed.empty()) << page << " no longer states the sleigh's speed after 60 s";
+  EXPECT_NEAR(stated_speed.front(), speed, 1e-14) << page << " states v = " << stated_speed.front();
+  EXPECT_TRUE(birkhoff_cart_test::page_bound_holds(page, "ends gliding at V to ", 0, std::abs(speed - motion.final_speed())));
+  EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, "turns through (π/2) Ω/λ to ", 0,
+                                                     std::abs(z(kSleighHeading) - motion.remaining_turn()), 0.25));
 }
 
 }  // namespace

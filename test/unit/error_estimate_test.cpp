@@ -22,6 +22,7 @@
 #include <cstdio>
 #include <limits>
 #include <cstring>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,7 @@
 #include "birkhoff_cart/core/run_summary.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
+#include "generated_docs.h"
 
 namespace birkhoff_cart {
 namespace {
@@ -185,7 +187,10 @@ std::vector<CartState> trajectory(Scene scene, bool estimate, int steps, StepSta
 
 TEST(BirkhoffianEstimate, OnlyObservesTheTrajectoryIsTheSameBitForBitWithItOnOrOff) {
   // The whirl (autonomous chart, angles reduced, first same as last) and the paper case (rep (a): a
-  // new chart epoch every step).
+  // new chart epoch every step). What the estimate costs, the evaluations a step with it on beyond
+  // those with it off, is docs/birkhoffian.md §10.5's table (generated_docs.h); the differences are
+  // the same on both stage-evaluation paths, the counts themselves are not.
+  std::map<std::string, std::string> rows;  // member → its cells
   for (const char* scene_name : {"jackknife_whirl", "paper_special"}) {
     Scene scene = load_scene(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/config/scenes/" + scene_name + ".yaml");
     scene.reference = ReferenceSettings{};
@@ -209,8 +214,18 @@ TEST(BirkhoffianEstimate, OnlyObservesTheTrajectoryIsTheSameBitForBitWithItOnOrO
                   static_cast<double>(without.rhs_evaluations) / 60.0,
                   static_cast<double>(with.passive_evaluations) / 60.0,
                   static_cast<double>(without.passive_evaluations) / 60.0);
+      char cells[64];
+      std::snprintf(cells, sizeof cells, " %.2f / %.2f |",
+                    static_cast<double>(with.rhs_evaluations - without.rhs_evaluations) / 60.0,
+                    static_cast<double>(with.passive_evaluations - without.passive_evaluations) / 60.0);
+      rows[integrator] += cells;
     }
   }
+  std::string table = "| member | jackknife_whirl: extra rhs / passive evaluations a step | paper_special (paper form) |\n|---|---|---|\n";
+  for (const std::string& integrator : integrator_names()) {
+    if (rows.count(integrator) != 0) table += "| `" + integrator + "` |" + rows[integrator] + "\n";
+  }
+  EXPECT_TRUE(birkhoff_cart_test::docs_part_is_current("docs/birkhoffian.md", "error_estimate_test", table));
 }
 
 TEST(BirkhoffianEstimate, ANewCommandIsSeenAtTheStepStartNotTheLastStepsEndRate) {

@@ -23,6 +23,7 @@
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
 #include "birkhoff_cart/core/singular_steering.h"
+#include "generated_docs.h"
 #include "test_scenes.h"
 
 namespace birkhoff_cart {
@@ -72,6 +73,15 @@ constexpr double kExtremeEnergyRelativeTolerance = 1e-2;
 using birkhoff_cart_test::scene_path;
 
 Scene shipped(const std::string& name) { return load_scene(scene_path(name)); }
+
+/// A figure of a generated table: two digits, or "< 1e-11" where it is round-off (its digits differ
+/// between the stage-evaluation paths and CPUs).
+std::string table_figure(double value) {
+  if (value < 1e-11) return "< 1e-11";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.2g", value);
+  return text;
+}
 
 /// Every field finite (time, coordinates, quasi-velocities, balances).
 bool all_finite(const CartState& state) {
@@ -170,10 +180,21 @@ RunOutcome run(const Scene& scene, double stiffness = 0.0 /* k_s [N·m/rad] */) 
 
 class PaperSingularity : public ::testing::TestWithParam<Method> {};
 
-TEST_P(PaperSingularity, StopsBeforeThePoleNamingTheSingularTime) {
-  Scene scene = with_method(shipped("paper_special"), GetParam());
-  scene.duration = 2.0;  // t₀ = π/2 → 3.57 s: past the pole at t = π
+/// The paper's special case run with `method` from t₀ = π/2 towards 3.57 s, past the pole at t = π.
+Scene past_the_pole(const Method& method) {
+  Scene scene = with_method(shipped("paper_special"), method);
+  scene.duration = 2.0;  // [s]
   scene.reference.kind = ReferenceSettings::Kind::kNone;
+  return scene;
+}
+
+/// |ω1 sin χ − 1| of a state (the exact solution has ω1 sin χ = 1) [-].
+double pole_invariant_error(const CartState& state) {
+  return std::abs(state.forward_speed * std::sin(state.steering_angle) - 1.0);
+}
+
+TEST_P(PaperSingularity, StopsBeforeThePoleNamingTheSingularTime) {
+  const Scene scene = past_the_pole(GetParam());
   const RunOutcome outcome = run(scene);
   const double h = scene.integrator.step_size;
   ASSERT_TRUE(outcome.stopped) << "ran across the pole to t = " << outcome.last.time
@@ -194,6 +215,21 @@ TEST_P(PaperSingularity, StopsBeforeThePoleNamingTheSingularTime) {
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryMethod, PaperSingularity, ::testing::ValuesIn(every_method()), method_label);
+
+// docs/hard_cases.md §1's table is generated from these runs (generated_docs.h).
+TEST(PaperSingularity, TheTableOfTheDocsIsTheStopOfEveryMember) {
+  std::string table = "| member | \\|ω1 sin χ − 1\\| at the stop, autonomous | paper form |\n|---|---|---|\n";
+  for (const std::string& integrator : integrator_names()) {
+    table += "| `" + integrator + "` |";
+    for (BirkhoffianForm form : {BirkhoffianForm::kAutonomous, BirkhoffianForm::kPaper}) {
+      const RunOutcome outcome = run(past_the_pole(Method{integrator, form}));
+      ASSERT_TRUE(outcome.stopped) << integrator << "/" << to_string(form);
+      table += " " + table_figure(pole_invariant_error(outcome.last)) + " |";
+    }
+    table += "\n";
+  }
+  EXPECT_TRUE(birkhoff_cart_test::docs_part_is_current("docs/hard_cases.md", "hard_cases_test §1", table));
+}
 
 TEST(PaperSingularity, RetryingTheRefusedStepLosesNothing) {
   Scene scene = shipped("paper_special");
@@ -285,18 +321,39 @@ TEST_P(Jackknife, ThroughQuarterAndWholeTurnsWithInvariantsKept) {
   const RunOutcome outcome = run(scene);
   const std::string label = c.scene + "/" + c.method.integrator + "/" + to_string(c.method.form);
   expect_free_invariants(outcome, label);
+  const std::string page = "docs/hard_cases.md";  // §2 states the angles every member reaches
   if (whirl) {
     // χ passes the jackknife angle π/2 (cos χ = 0) and goes on through whole turns, unwrapped.
     EXPECT_LT(outcome.min_steering_angle, M_PI / 2.0) << label;
     EXPECT_GT(outcome.max_steering_angle - outcome.min_steering_angle, kWhirlMinimumTurns * 2.0 * M_PI) << label;
+    EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, "passes π/2 and turns χ from 1.2 to ", 0,
+                                                       outcome.max_steering_angle, 1.5e-4)) << label;
   } else {
     // The near jackknife creeps up to π/2 without folding.
     EXPECT_GT(outcome.max_steering_angle, M_PI / 2.0 - kNearJackknifeApproach) << label;
+    EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, "`near_jackknife` (6 s) creeps to χ = ", 0,
+                                                       outcome.max_steering_angle, 4e-4)) << label;
   }
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryMethod, Jackknife,
                          ::testing::ValuesIn(free_cases({"near_jackknife", "jackknife_whirl"})), free_label);
+
+// docs/hard_cases.md §2's table is generated from these runs (generated_docs.h): the whirl of the
+// test above, for every member in both forms.
+TEST(Jackknife, TheWhirlTableOfTheDocsIsTheRunOfEveryMember) {
+  std::string table = "| member (form) | whirl max \\|ΔT*\\|/T*₀ | whirl max \\|Δp2\\| [kg·m²/s] |\n|---|---|---|\n";
+  for (const Method& method : every_method()) {
+    Scene scene = with_method(shipped("jackknife_whirl"), method);
+    scene.duration = kWhirlDuration;
+    const RunOutcome outcome = run(scene);
+    ASSERT_FALSE(outcome.stopped) << method.integrator << ": " << outcome.error;
+    table += "| `" + method.integrator + "` (" + to_string(method.form) + ") | " +
+             table_figure(outcome.max_energy_residual / outcome.initial_energy) + " | " +
+             table_figure(outcome.max_p2_residual) + " |\n";
+  }
+  EXPECT_TRUE(birkhoff_cart_test::docs_part_is_current("docs/hard_cases.md", "hard_cases_test §2", table));
+}
 
 class ReverseDriving : public ::testing::TestWithParam<FreeCase> {};
 
@@ -315,7 +372,18 @@ TEST_P(ReverseDriving, InvariantsKeptWhileTheStateDiverges) {
     neighbour.step();
     separation = std::max(separation, std::abs(nominal.state().steering_angle - neighbour.state().steering_angle));
   }
-  expect_free_invariants(run(scene), label);
+  const RunOutcome outcome = run(scene);
+  expect_free_invariants(outcome, label);
+  // docs/hard_cases.md §3 states the bounds every member keeps here.
+  const std::string page = "docs/hard_cases.md";
+  EXPECT_TRUE(birkhoff_cart_test::page_bound_holds(page, "The test checks the\ninvariants, not the state: energy ≤ ", 0,
+                                                   outcome.max_energy_residual / outcome.initial_energy)) << label;
+  EXPECT_TRUE(birkhoff_cart_test::page_bound_holds(page, "(birkhoff2 paper) and ≤ ", 0,
+                                                   label == "reverse_jackknife/birkhoff2/paper" ? 0.0 : outcome.max_p2_residual))
+      << label;
+  if (label == "reverse_jackknife/birkhoff2/paper") {
+    EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, "1e-10), p2 ≤ ", 0, outcome.max_p2_residual, 0.06));
+  }
   // The reversing cart leaves the straight line χ = 0 and folds up (the state diverges from it) ...
   EXPECT_GT(std::abs(nominal.state().steering_angle), kReverseFoldAngle) << label;
   // ... and a 1e-9 rad/s change of ω2 grows by orders of magnitude on the way: no comparison with
@@ -324,6 +392,9 @@ TEST_P(ReverseDriving, InvariantsKeptWhileTheStateDiverges) {
   EXPECT_GT(growth, kReverseMinimumGrowth) << label;
   std::printf("[ measured ] %s: final chi %.6f rad, a %.0e rad/s change of omega2 grows x%.3g\n", label.c_str(),
               nominal.state().steering_angle, kReversePerturbation, growth);
+  EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, "χ runs from 0 to ", 0, nominal.state().steering_angle, 2e-4))
+      << label;
+  EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, "largest |Δχ| over the run is ", 0, growth, 2e-3)) << label;
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryMethod, ReverseDriving, ::testing::ValuesIn(free_cases({"reverse_jackknife"})),
@@ -354,9 +425,12 @@ bool stays_bounded(const RunOutcome& outcome, double initial_mechanical_energy) 
 
 TEST(StiffHinge, ExplicitMethodsBreakAtOneMillisecondImplicitSymmetricOnesStayBounded) {
   const std::vector<double> steps = {1e-4, 2e-4, 5e-4, 1e-3, 2e-3, 5e-3, 1e-2, 2e-2};  // h [s]
+  // docs/hard_cases.md §4's table is generated from these runs (generated_docs.h).
+  std::string table = "| member | bounded at 1 ms | first breakdown |\n|---|---|---|\n";
   for (const std::string& integrator : integrator_names()) {
     bool stable_at_millisecond = false;
     std::string breakdown = "none";
+    std::string first_breakdown = "none up to " + std::to_string(static_cast<int>(std::lround(steps.back() * 1e3))) + " ms";
     for (double h : steps) {
       const Scene scene = stiff_hinge(integrator, h);
       const double chi0 = scene.initial_state.steering_angle;
@@ -375,11 +449,14 @@ TEST(StiffHinge, ExplicitMethodsBreakAtOneMillisecondImplicitSymmetricOnesStayBo
                       outcome.stopped ? "StepError" : "energy grew x" /* see factor below */);
         breakdown = text;
         if (!outcome.stopped) breakdown += std::to_string(outcome.max_mechanical_energy / initial);
+        std::snprintf(text, sizeof text, "%g ms (%s)", h * 1e3, outcome.stopped ? "StepError" : "energy grew");
+        first_breakdown = text;
       }
     }
     std::printf("[ measured ] stiff hinge (k_s = %.0e N m/rad, b = %.0e N m s/rad) %s: stable at 1 ms: %s, first breakdown: %s\n",
                 kStiffStiffness, kStiffDamping, integrator.c_str(), stable_at_millisecond ? "yes" : "no",
                 breakdown.c_str());
+    table += "| `" + integrator + "` | " + (stable_at_millisecond ? "yes" : "no") + " | " + first_breakdown + " |\n";
     if (integrator == "rk2" || integrator == "rk4") {
       EXPECT_FALSE(stable_at_millisecond) << integrator << " is not broken by this hinge: not stiff enough";
     }
@@ -387,6 +464,7 @@ TEST(StiffHinge, ExplicitMethodsBreakAtOneMillisecondImplicitSymmetricOnesStayBo
       EXPECT_TRUE(stable_at_millisecond) << integrator;
     }
   }
+  EXPECT_TRUE(birkhoff_cart_test::docs_part_is_current("docs/hard_cases.md", "hard_cases_test §4", table));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -500,6 +578,18 @@ TEST(ExtremeParameters, EveryExtremeCartRunsWithItsInvariantsKept) {
         std::printf("[ measured ] extreme %s: %s, max |dT*|/T*0 = %.3g, chi in [%.3g, %.3g] rad\n", label.c_str(),
                     outcome.stopped ? outcome.error.c_str() : "ran", outcome.max_energy_residual / outcome.initial_energy,
                     outcome.min_steering_angle, outcome.max_steering_angle);
+        // docs/hard_cases.md §6 states the energy drift of these runs.
+        const double drift = outcome.max_energy_residual / outcome.initial_energy;
+        const std::string page = "docs/hard_cases.md";
+        if (cart.step_size == 1e-5) {
+          EXPECT_TRUE(birkhoff_cart_test::page_bound_holds(page, "all three keep energy to ", 0, drift)) << label;
+        } else if (std::string(integrator) == "rk4") {
+          EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, "identical dimensionless\nbehaviour, energy drift ", 2, drift, 0.06))
+              << label;
+        } else {
+          EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, "identical dimensionless\nbehaviour, energy drift ", 0, drift, 0.06))
+              << label;
+        }
       } catch (const std::invalid_argument& error) {
         ADD_FAILURE() << label << " refused at construction: " << error.what();
       }

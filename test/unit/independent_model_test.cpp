@@ -20,6 +20,7 @@
 #include "birkhoff_cart/core/effects/steering_damping.h"
 #include "birkhoff_cart/core/effects/steering_stiffness.h"
 #include "full_coordinate_model.h"
+#include "generated_docs.h"
 
 namespace birkhoff_cart {
 namespace {
@@ -231,6 +232,15 @@ TEST(ReducedModel, ReducedRightHandSideMatchesCartModel) {
 }
 
 // At random admissible states the full model's q̈, mapped to (ω̇1, ω̇2), is the reduced ω̇.
+/// docs/derivation.md's table of the independent model states `measured` as the last figure of the
+/// row that starts with `row` (two digits: 6 %; "4·10⁻¹⁵", one digit: 25 %).
+void expect_the_derivation_table_states(const std::string& row, double measured, double tolerance = 0.06) {
+  const std::string page = "docs/derivation.md";
+  const std::size_t figures = birkhoff_cart_test::figures_after(page, "| " + row + " | ").size();
+  ASSERT_GT(figures, 0u) << page << " has no row '" << row << "'";
+  EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, "| " + row + " | ", figures - 1, measured, tolerance));
+}
+
 TEST(IndependentModel, InstantaneousAccelerationsAgreeAtRandomStates) {
   const CartParameters parameters;
   const CartModel model(parameters);
@@ -260,6 +270,7 @@ TEST(IndependentModel, InstantaneousAccelerationsAgreeAtRandomStates) {
     EXPECT_NEAR(qdd(3), reduced(1), kAccelerationTolerance * scale) << "trial " << trial;
   }
   std::cout << "[ measured ] max relative |ω̇_full − ω̇_reduced| over 200 random states: " << worst << "\n";
+  expect_the_derivation_table_states("ω̇ at 200 random states (relative)", worst, 0.25);
 }
 
 /// CartModel's reduced accelerations ω̇ (docs eq. (3.4)) in the form compare_trajectories takes.
@@ -301,6 +312,7 @@ TEST(IndependentModel, TrajectoriesAgreeUnderSteeringAndDriveTorque) {
             << ", full-model constraint drift " << result.max_constraint_residual << " m/s, χ in ["
             << result.min_steering_angle << ", " << result.max_steering_angle << "] rad, final ω1 "
             << result.final_forward_speed << " m/s\n";
+  expect_the_derivation_table_states("steering + drive torque, χ ∈ [0.25, 0.91] rad", result.max_difference);
   EXPECT_LT(result.max_difference, kTrajectoryTolerance);
   EXPECT_LT(result.max_constraint_residual, kConstraintDriftTolerance);
   EXPECT_GT(result.final_forward_speed, 2.0);  // the drive torque really drove the cart
@@ -319,6 +331,7 @@ TEST(IndependentModel, TrajectoriesAgreeWhileSteeringSwingsThroughRightAngles) {
   q0 << -1.0, 2.0, -0.7, 0.0, 0.0, 0.0, 0.0, 0.0;
   const Comparison result =
       compare_trajectories(parameters, cart_model_acceleration(model), history, q0, 0.8, -4.6, 5.0);
+  expect_the_derivation_table_states("steering swinging through ±π/2 (χ ∈ [−1.86, 5.52] rad)", result.max_difference);
   std::cout << "[ measured ] 5 s, χ through ±π/2: max disagreement " << result.max_difference
             << ", full-model constraint drift " << result.max_constraint_residual << " m/s, χ in ["
             << result.min_steering_angle << ", " << result.max_steering_angle << "] rad\n";
@@ -382,6 +395,9 @@ TEST(IndependentModel, TrajectoriesAgreeWithRollingResistanceAirDragAndHingeSpri
   q0 << 0.0, 0.0, 0.2, -0.3, 0.0, 0.0, 0.0, 0.0;
   const Comparison result = compare_trajectories(p, cart_model_acceleration(model), history, q0, 2.0, 0.5, 5.0,
                                                  reduced_effects, full_effects);
+  expect_the_derivation_table_states("rolling resistance, air drag, hinge damper and spring (4.3)–(4.6) from the core's "
+                                     "`EffectSet` vs. the same loads applied per wheel / at A / on χ in q",
+                                     result.max_difference);
   std::cout << "[ measured ] 5 s, all dissipative effects: max disagreement " << result.max_difference
             << ", χ in [" << result.min_steering_angle << ", " << result.max_steering_angle << "] rad, final ω1 "
             << result.final_forward_speed << " m/s\n";
@@ -404,6 +420,7 @@ TEST(IndependentModel, PaperPrintedMu1IsRefutedByTheFullModel) {
   };
   const Comparison result = compare_trajectories(parameters, printed_acceleration, history, q0, 1.2, 0.4, 5.0);
   std::cout << "[ measured ] 5 s with the printed μ1: max disagreement " << result.max_difference << "\n";
+  expect_the_derivation_table_states("as the first trajectory, with the printed μ1 of eq. (19)", result.max_difference);
   EXPECT_GT(result.max_difference, kPrintedMu1Disagreement);
 }
 

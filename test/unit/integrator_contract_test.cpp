@@ -19,6 +19,7 @@
 #include "birkhoff_cart/core/integrators/cart_stepper.h"
 #include "birkhoff_cart/core/integrators/integrator_members.h"
 #include "birkhoff_cart/core/scene.h"
+#include "generated_docs.h"
 #include "registry_members.h"
 #include "test_systems.h"
 
@@ -386,6 +387,40 @@ Eigen::Vector4d run_sleigh(const Stepper& stepper, const ChaplyginSleigh& sleigh
   return z;
 }
 
+// docs/integrators.md's table of the sleigh ("measured, every registry member") states what these
+// tests measure: each typed test checks its member's figure there. A row is found by its test's
+// name in its first cell; a member's figures are those of the group naming it ("3.97–4.00
+// (`birkhoff_gauss4`, …)"), or the figure after its name; the symmetric members share a bound.
+const char kSleighPage[] = "docs/integrators.md";
+constexpr double kStatedOrder = 0.005;  // the page's orders are to two decimals [-]
+constexpr double kStatedFigure = 0.06;  // relative, a two-digit figure [-]
+
+std::string sleigh_row(const std::string& test) {
+  return birkhoff_cart_test::line_after(kSleighPage, "`" + test + "`) | ");
+}
+
+/// The first figure after `marker` in `row`; NaN when the row lacks the marker.
+double figure_after(const std::string& row, const std::string& marker) {
+  const auto at = row.find(marker);
+  const std::vector<double> figures =
+      at == std::string::npos ? std::vector<double>{} : birkhoff_cart_test::figures_in(row.substr(at + marker.size()));
+  return figures.empty() ? std::numeric_limits<double>::quiet_NaN() : figures.front();
+}
+
+/// The member's measured `value` is what the sleigh table's `row` states for it: within the
+/// symmetric members' bound (after "symmetric members ≤ "), or, for another member, within 6 % of the
+/// figure after its name.
+void expect_sleigh_figure(const std::string& row, const std::string& member, bool symmetric, double value) {
+  if (symmetric) {
+    const double bound = figure_after(row, "symmetric members ≤ ");
+    EXPECT_LE(value, bound) << kSleighPage << " states the symmetric members' bound " << bound << " in: " << row;
+  } else {
+    const double stated = figure_after(row, "`" + member + "` ");
+    EXPECT_NEAR(value, stated, kStatedFigure * value) << kSleighPage << " states " << stated << " for " << member
+                                                      << " in: " << row;
+  }
+}
+
 int sleigh_base_steps(int order) { return order == 2 ? 100 : order == 4 ? 30 : order == 6 ? 12 : 8; }
 
 TYPED_TEST(IntegratorContract, ObservedOrderOnTheChaplyginSleigh) {
@@ -415,6 +450,13 @@ TYPED_TEST(IntegratorContract, ObservedOrderOnTheChaplyginSleigh) {
                   e1, e2, e3, order12, order23);
       expect_order(order12, TypeParam::kOrder, "sleigh");
       expect_order(order23, TypeParam::kOrder, "sleigh");
+      const std::vector<double> stated =
+          birkhoff_cart_test::group_figures(sleigh_row("ObservedOrderOnTheChaplyginSleigh"), TypeParam::name());
+      ASSERT_FALSE(stated.empty()) << kSleighPage << "'s sleigh table states no order for " << TypeParam::name();
+      for (double order : {order12, order23}) {
+        EXPECT_GE(order, stated.front() - kStatedOrder) << kSleighPage << " states " << stated.front() << " for " << TypeParam::name();
+        EXPECT_LE(order, stated.back() + kStatedOrder) << kSleighPage << " states " << stated.back() << " for " << TypeParam::name();
+      }
     }
   }
 }
@@ -430,6 +472,8 @@ TYPED_TEST(IntegratorContract, ChaplyginSleighEnergyOverALongRun) {
   double energy_error = 0.0;
   run_sleigh(this->stepper_, sleigh, z0, kSleighLongRun, steps, &energy_error);
   std::printf("%s sleigh over %g s: max |dE/E| %.3e\n", TypeParam::name(), kSleighLongRun, energy_error);
+  expect_sleigh_figure(sleigh_row("ChaplyginSleighEnergyOverALongRun"), TypeParam::name(), TypeParam::kSymmetric,
+                       energy_error);
   if (TypeParam::kSymmetric) {
     EXPECT_LE(energy_error, kSleighEnergyRoundOff);
   } else {
@@ -454,6 +498,10 @@ TYPED_TEST(IntegratorContract, ChaplyginSleighIsReversedOnlyBySymmetricMembers) 
                                                2.0, kSteps));
   const double defect = (back - z0).cwiseAbs().maxCoeff() / std::max(1.0, z0.cwiseAbs().maxCoeff());
   std::printf("%s sleigh: reversal defect %.3e\n", TypeParam::name(), defect);
+  if (!kAdaptive<TypeParam>) {
+    expect_sleigh_figure(sleigh_row("ChaplyginSleighIsReversedOnlyBySymmetricMembers"), TypeParam::name(),
+                         TypeParam::kSymmetric, defect);
+  }
   if (TypeParam::kSymmetric) {
     EXPECT_LE(defect, kSymmetryTolerance);
   } else if (!kAdaptive<TypeParam>) {

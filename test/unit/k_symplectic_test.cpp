@@ -22,6 +22,7 @@
 #include "birkhoff_cart/core/integrators/birkhoff_symplectic.h"
 #include "birkhoff_cart/core/integrators/implicit_midpoint.h"
 #include "birkhoff_cart/core/integrators/runge_kutta.h"
+#include "generated_docs.h"
 #include "registry_members.h"
 #include "test_systems.h"
 
@@ -147,7 +148,8 @@ const double kStepSizes[] = {1e-3, 1e-2, 0.1};  // h [s]
 const double kViolationStepSizes[] = {0.1, 0.2};  // h [s]
 
 template <class Stepper>
-void expect_k_symplectic_on_all_systems(const Stepper& stepper, double tolerance = kSymplecticityTolerance) {
+/// Returns the worst defect [-].
+double expect_k_symplectic_on_all_systems(const Stepper& stepper, double tolerance = kSymplecticityTolerance) {
   StepStatistics statistics;
   double worst = 0.0;
   DampedOscillator oscillator;
@@ -195,6 +197,7 @@ void expect_k_symplectic_on_all_systems(const Stepper& stepper, double tolerance
   std::printf("[ measured ] %s: worst K-symplecticity defect %.3e; Newton iterations %llu over %llu rhs evaluations\n",
               Stepper::name(), worst, static_cast<unsigned long long>(statistics.newton_iterations_total),
               static_cast<unsigned long long>(statistics.rhs_evaluations));
+  return worst;
 }
 
 /// The typed suites below run over the Birkhoffian members of the registry (integrator_members.h),
@@ -209,7 +212,14 @@ TYPED_TEST_SUITE(BirkhoffianMember, birkhoff_cart_test::BirkhoffianSteppers, bir
 TYPED_TEST(BirkhoffianMember, PreservesTheStructureOnEverySystem) {
   // A defect ≤ 1e-13 on the Λ = 0 systems: the oscillators with constant, time-dependent and
   // nonlinear charts, and the cart's Birkhoffian part in both forms.
-  expect_k_symplectic_on_all_systems(this->stepper_, kMemberSymplecticityTolerance);
+  const double worst = expect_k_symplectic_on_all_systems(this->stepper_, kMemberSymplecticityTolerance);
+  // docs/integrators.md states the bound every member keeps, in three places.
+  for (const char* context : {"(Mᵀ K M = K by AD to ≤ ", "Every Birkhoffian member passes to ≤ ",
+                              "(`k_symplectic_test`, `BirkhoffianMember`) | every Birkhoffian member ≤ "}) {
+    EXPECT_TRUE(birkhoff_cart_test::page_bound_holds("docs/integrators.md", context, 0, worst)) << TypeParam::name();
+  }
+  EXPECT_TRUE(birkhoff_cart_test::page_bound_holds("docs/birkhoffian.md", "worst K-symplecticity defect ≤ ", 0, worst))
+      << TypeParam::name();
 }
 
 TYPED_TEST(BirkhoffianMember, ForwardThenBackwardStepReturnsToTheStart) {
@@ -224,6 +234,9 @@ TYPED_TEST(BirkhoffianMember, ForwardThenBackwardStepReturnsToTheStart) {
       EXPECT_LE(symmetry_defect(this->stepper_, full_a, zc, 7.0, h), kSymmetryTolerance) << h;
       EXPECT_LE(symmetry_defect(this->stepper_, full_b, zc, 7.0, h), kSymmetryTolerance) << h;
     }
+    // docs/integrators.md's sleigh table states the bound this test asserts.
+    EXPECT_TRUE(birkhoff_cart_test::page_bound_holds(
+        "docs/integrators.md", "(`k_symplectic_test`) | every Birkhoffian member ≤ ", 0, kSymmetryTolerance));
     for (double gamma : {0.0, 1.0}) {  // the sleigh with its blade, both forms
       const ChaplyginSleigh sleigh = sleigh_form(gamma, true);
       EXPECT_LE(symmetry_defect(this->stepper_, sleigh, sleigh.state(0.2, 0.4, -0.5, 1.7), 0.8, h), kSymmetryTolerance)
@@ -243,6 +256,9 @@ TEST(KSymplecticity, ClassicalRungeKutta4ViolatesIt) {
     std::printf("[ measured ] rk4 h = %g: damped oscillator %.3e, cubic chart %.3e\n", h, d1, d2);
     EXPECT_GE(d1, kViolationFactor * kSymplecticityTolerance) << "h = " << h;
     EXPECT_GE(d2, kViolationFactor * kSymplecticityTolerance) << "h = " << h;
+    // docs/birkhoffian.md §7 quotes the damped oscillator's defects at h = 0.1 and 0.2 (figures 0, 2).
+    EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/birkhoffian.md", "On the damped oscillator rk4 misses by ",
+                                                       h == 0.1 ? 0 : 2, d1, 0.06)) << "h = " << h;
   }
 }
 
@@ -261,6 +277,13 @@ TEST(KSymplecticity, NonlinearTimeDependentChartSeparatesBirkhoffFromRk4AndMidpo
     const double midpoint = symplecticity_defect(ImplicitMidpoint{}, system, z, 0.4, h, statistics);
     std::printf("[ measured ] cubic damped chart h = %g: birkhoff2 %.3e, birkhoff4 %.3e, rk4 %.3e, midpoint in z %.3e\n",
                 h, birkhoff2, birkhoff4, rk4, midpoint);
+    if (h == 0.1) {  // docs/birkhoffian.md §7 quotes them: figures 0, 2, 4, 5 ("birkhoff4" and "rk4" give a 4 each)
+      const char context[] = "On the cubic damped chart (B.22) at h = 0.1, the defects are birkhoff2 ";
+      EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/birkhoffian.md", context, 0, birkhoff2, 0.06));
+      EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/birkhoffian.md", context, 2, birkhoff4, 0.06));
+      EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/birkhoffian.md", context, 4, rk4, 0.06));
+      EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/birkhoffian.md", context, 5, midpoint, 0.06));
+    }
     EXPECT_LE(birkhoff2, kSymplecticityTolerance) << "h = " << h;
     EXPECT_LE(birkhoff4, kSymplecticityTolerance) << "h = " << h;
     EXPECT_GE(rk4, kViolationFactor * kSymplecticityTolerance) << "h = " << h;
@@ -284,6 +307,10 @@ TEST(KSymplecticity, TheSleighsPaperFormSeparatesBirkhoffFromRk4AndMidpointInZ) 
     EXPECT_LE(birkhoff2, kMemberSymplecticityTolerance) << "h = " << h;
     EXPECT_GE(rk4, kViolationFactor * kSymplecticityTolerance) << "h = " << h;
     EXPECT_GE(midpoint, kViolationFactor * kSymplecticityTolerance) << "h = " << h;
+    if (h == 0.1) {  // docs/integrators.md's sleigh table quotes them (one digit)
+      EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/integrators.md", "on the eᵗ form rk4 ", 0, rk4, 0.25));
+      EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/integrators.md", "on the eᵗ form rk4 ", 1, midpoint, 0.25));
+    }
   }
 }
 
@@ -306,6 +333,12 @@ TEST(KSymplecticity, Birkhoff2InTheWrongChartViolatesIt) {
                 d1, d2);
     EXPECT_GE(d1, kViolationFactor * kSymplecticityTolerance) << "h = " << h;
     EXPECT_GE(d2, kViolationFactor * kSymplecticityTolerance) << "h = " << h;
+    if (h == 0.1) {  // docs/birkhoffian.md §7 quotes the three defects at h = 0.1
+      const char context[] = "birkhoff2 in the identity chart by ";
+      EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/birkhoffian.md", context, 0, d1, 0.06));
+      EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/birkhoffian.md", context, 1, d2, 0.06));
+      EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/birkhoffian.md", context, 2, d3, 0.06));
+    }
   }
 }
 

@@ -17,6 +17,7 @@
 #include "birkhoff_cart/core/cart_birkhoffian.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
+#include "generated_docs.h"
 
 namespace birkhoff_cart {
 namespace {
@@ -105,6 +106,23 @@ TEST(LongHorizon, OneDrivenHourInBothRepresentationsKeepsItsBalances) {
     EXPECT_GT(outcome->last.forward_speed, 1.0) << form << ": the driven cart should still be cruising";
   }
   EXPECT_NEAR(autonomous.last.forward_speed, paper.last.forward_speed, kFormAgreementSpeed);
+  // docs/hard_cases.md §7 quotes these runs (wall time aside): two-digit figures within 6 %, round-off
+  // as the bound it states, ω1 to the six decimals shown.
+  const std::string page = "docs/hard_cases.md";
+  for (const HourOutcome* outcome : {&autonomous, &paper}) {
+    const std::string row = std::string("| ") + (outcome == &autonomous ? "autonomous" : "paper") + " | ";
+    const std::vector<double> stated = birkhoff_cart_test::figures_after(page, row);
+    ASSERT_EQ(stated.size(), 4u) << page << " §7: the row '" << row << "' should state 4 figures";
+    const std::string form = row + "...";
+    EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, row, 0, outcome->max_energy_balance, 0.06)) << form;
+    if (outcome == &autonomous) {
+      EXPECT_LE(outcome->max_p2_balance, stated[1]) << form;
+    } else {
+      EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, row, 1, outcome->max_p2_balance, 0.06)) << form;
+    }
+    EXPECT_LE(outcome->max_constraint, stated[2]) << form;
+    EXPECT_NEAR(outcome->last.forward_speed, stated[3], 5e-7) << form;
+  }
 }
 
 }  // namespace

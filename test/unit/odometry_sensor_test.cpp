@@ -13,6 +13,7 @@
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/sensors/odometry_sensor.h"
 #include "birkhoff_cart/core/simulation.h"
+#include "generated_docs.h"
 #include "test_scenes.h"
 
 namespace birkhoff_cart {
@@ -83,6 +84,11 @@ TEST(OdometrySensor, NoiseFreeItFollowsTheTruthWithEveryHeadingSource) {
     EXPECT_LT(error.head<2>().norm(), 2e-5 * path_length()) << to_string(source);
     EXPECT_LT(error.head<2>().norm(), coarse_error.head<2>().norm() / 3.0) << to_string(source);
     EXPECT_LT(std::abs(error(2)), 1e-5) << to_string(source);
+    // docs/odometry_sensor.md quotes the error at 100 Hz (two digits): the first figure for the
+    // wheels and the gyro, the second for the steering readings.
+    EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees("docs/odometry_sensor.md", "read at 100 Hz) the error at the end is ",
+                                                       source == HeadingSource::kSteering ? 1 : 0,
+                                                       error.head<2>().norm(), 0.06)) << to_string(source);
     EXPECT_EQ(estimate.pose_covariance.norm(), 0.0) << to_string(source);
     EXPECT_EQ(estimate.readings, slalom_states().size() - 1);
   }
@@ -203,6 +209,15 @@ void expect_drift_matches_covariance(OdometrySensorSettings settings, int seeds,
               heading_ratio, seeds);
   // A variance from n samples has a relative standard deviation of about √(2/n) (4.5 % at 1000): the
   // bounds are more than 3 of those, plus the linearization's share.
+  // docs/odometry_sensor.md's table states these figures (3 digits): the last four of the row.
+  const std::string page = "docs/odometry_sensor.md";
+  const std::string row = std::string("| ") + what + " | ";
+  const std::size_t stated = birkhoff_cart_test::figures_after(page, row).size();
+  ASSERT_GE(stated, 4u) << page << " has no row '" << row << "'";
+  EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, row, stated - 4, std::sqrt(predicted.topLeftCorner<2, 2>().trace()), 0.005));
+  EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(page, row, stated - 3, std::sqrt(predicted(2, 2)), 0.005));
+  EXPECT_NEAR(birkhoff_cart_test::figures_after(page, row)[stated - 2], position_ratio, 5.01e-4) << page << ", " << what;
+  EXPECT_NEAR(birkhoff_cart_test::figures_after(page, row)[stated - 1], heading_ratio, 5.01e-4) << page << ", " << what;
   EXPECT_NEAR(position_ratio, 1.0, 0.2) << what;
   EXPECT_NEAR(heading_ratio, 1.0, 0.2) << what;
   for (int axis = 0; axis < 3; ++axis) {

@@ -29,6 +29,7 @@
 #include "birkhoff_cart/core/integrators/integrator_registry.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
+#include "generated_docs.h"
 
 namespace birkhoff_cart {
 namespace {
@@ -217,6 +218,48 @@ TEST_P(RegistryMember, SteeringMomentumBalanceIsExactInTheAutonomousForm) {
     EXPECT_GE(paper.worst_defect, 0.02 * departure);  // measured ratios 0.73 (birkhoff2), 0.14 (birkhoff4)
   } else {
     EXPECT_LE(paper.worst_defect, kRoundOff);
+  }
+}
+
+// docs/integrators.md's table "What each step map preserves" and docs/birkhoffian.md §9's quote
+// these reversal defects (the runs above, at h = 0.1 s over 2 s each way, dopri5 at its tolerance
+// 1e-5): the pages' figures are within 25 % (one digit) or 6 % (two digits) of what is measured
+// here, and their round-off bound holds for every symmetric member in the autonomous form.
+struct StepMapQuote {
+  const char* page;
+  const char* bound;      ///< the text before the symmetric members' bound
+  const char* birkhoff2;  ///< the text before birkhoff2's paper-form defect
+  const char* birkhoff4;  ///< the text before birkhoff4's paper-form defect
+  const char* peers;      ///< the text before rk2's, rk4's and dopri5's autonomous defects
+  double tolerance;       ///< relative [-]
+};
+
+TEST(StepMapTable, TheFiguresOfTheDocsAreTheMeasuredReversalDefects) {
+  const Runner runner(load("free_coast"));
+  const auto defect = [&](const std::string& name, BirkhoffianForm form) {
+    const IntegratorSettings settings = settings_for(name, form);
+    return std::max(reversal_defect(runner, settings, momentum_flip),
+                    reversal_defect(runner, settings, steering_reflection));
+  };
+  double symmetric_worst = 0.0;
+  for (const auto& name : names()) {
+    if (integrator_entry(name).symmetric) symmetric_worst = std::max(symmetric_worst, defect(name, BirkhoffianForm::kAutonomous));
+  }
+  const double birkhoff2 = defect("birkhoff2", BirkhoffianForm::kPaper);
+  const double birkhoff4 = defect("birkhoff4", BirkhoffianForm::kPaper);
+  const double peers[] = {defect("rk2", BirkhoffianForm::kAutonomous), defect("rk4", BirkhoffianForm::kAutonomous),
+                          defect("dopri5", BirkhoffianForm::kAutonomous)};
+  for (const StepMapQuote& quote :
+       {StepMapQuote{"docs/integrators.md", "reversible under R₁ and R₂ to round-off (≤ ", "**not reversible** (",
+                     "on Λ = 0; not reversible (", "| `rk2`, `rk4`, `dopri5` | not reversible (", 0.25},
+        StepMapQuote{"docs/birkhoffian.md", "reversible under R₁ and R₂ to round-off (defects ≤ ",
+                     "**Not reversible** (defect ", "Not reversible (", "not symmetric, not reversible (defects ", 0.06}}) {
+    EXPECT_TRUE(birkhoff_cart_test::page_bound_holds(quote.page, quote.bound, 0, symmetric_worst));
+    EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(quote.page, quote.birkhoff2, 0, birkhoff2, quote.tolerance));
+    EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(quote.page, quote.birkhoff4, 0, birkhoff4, quote.tolerance));
+    for (std::size_t k = 0; k < 3; ++k) {
+      EXPECT_TRUE(birkhoff_cart_test::page_figure_agrees(quote.page, quote.peers, k, peers[k], quote.tolerance));
+    }
   }
 }
 

@@ -15,6 +15,7 @@
 
 #include "birkhoff_cart/core/effect_library.h"
 #include "birkhoff_cart/core/scene.h"
+#include "generated_docs.h"
 #include "test_scenes.h"
 
 namespace birkhoff_cart {
@@ -358,6 +359,9 @@ TEST_F(SceneFiles, MalformedScenesNameTheFileAndTheKey) {
       {"empty_file", "", "(document)"},
   };
   ASSERT_GE(cases.size(), 15u);
+  // The pages that count these cases state this count.
+  EXPECT_TRUE(birkhoff_cart_test::page_states("docs/developing.md", std::to_string(cases.size()) + " malformed scenes, each"));
+  EXPECT_TRUE(birkhoff_cart_test::page_states("docs/hard_cases.md", "scene_test.cpp covers " + std::to_string(cases.size()) + " malformed"));
   for (const MalformedCase& malformed : cases) {
     const std::string path = write(malformed.label, malformed.text);
     try {
