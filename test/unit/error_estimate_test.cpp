@@ -13,7 +13,8 @@
 // bounds the true error with slope s + 2 (Gauss) or 4 (compositions: the sub-steps' O(h³) error vectors,
 // summed, cancel to O(h⁴) since Σγᵢ³ = 0); the
 // estimate only observes (bit-for-bit trajectory with it on or off); a new command torque is not
-// mistaken for the last step's end rate. The estimate-to-true ratios are printed.
+// mistaken for the last step's end rate. The estimate-to-true ratios are printed; docs/accuracy.md §1's table
+// is generated from these steps (generated_docs.h).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -171,6 +172,73 @@ INSTANTIATE_TEST_SUITE_P(
     [](const ::testing::TestParamInfo<BoundExpectation>& info) { return std::string(info.param.integrator); });
 
 bool is_birkhoffian(const std::string& integrator) { return integrator.rfind("birkhoff", 0) == 0; }
+
+/// `value` with `digits` digits after the point in the pages' exponent style: 1.7e-3, 9.1e4 [-].
+std::string compact_exponent(double value, int digits) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.*e", digits, value);
+  std::string out(text);
+  const auto e = out.find('e');
+  const bool negative = out[e + 1] == '-';
+  std::string exponent = out.substr(e + 2);
+  exponent.erase(0, std::min(exponent.find_first_not_of('0'), exponent.size() - 1));
+  return out.substr(0, e) + "e" + (negative ? "-" : "") + exponent;
+}
+
+/// ê / true error as the page writes it: 2.1, 95, 477, 9.1e4 [-].
+std::string ratio_as_written(double ratio) {
+  char text[32];
+  if (ratio < 10.0) {
+    std::snprintf(text, sizeof text, "%.1f", ratio);
+  } else if (ratio < 1000.0) {
+    std::snprintf(text, sizeof text, "%.0f", ratio);
+  } else {
+    return compact_exponent(ratio, 1);
+  }
+  return text;
+}
+
+TEST(LocalErrorEstimate, TheAccuracyPagesTableIsWhatTheseStepsMeasure) {
+  // docs/accuracy.md §1's table: one step of h and of h/2 from the exact state at t = 2 s, as the
+  // tests above take them; the Gauss members of six and eight stages at a longer step, where their
+  // true error is above round-off.
+  struct Row {
+    const char* integrator;
+    double step;         ///< h [s]
+    int expected_ratio;  ///< 2^(p̂+1) of ê(h)/ê(h/2); 0: adaptive, no fixed ratio
+  };
+  const Row rows[] = {{"rk2", 0.02, 4},
+                      {"rk4", 0.02, 8},
+                      {"midpoint", 0.02, 4},
+                      {"dopri5", 0.02, 0},
+                      {"birkhoff2", 0.02, 8},
+                      {"birkhoff_gauss4", 0.02, 16},
+                      {"birkhoff_gauss6", 0.08, 32},
+                      {"birkhoff_gauss8", 0.16, 64},
+                      {"birkhoff4", 0.02, 16},
+                      {"birkhoff4_suzuki", 0.02, 16}};
+  std::string table =
+      "| method | h = 0.02 s: ê | true | ê / true | h = 0.01 s: ê | ê(h)/ê(h/2) (expected) |\n"
+      "|---|---|---|---|---|---|\n";
+  for (const Row& row : rows) {
+    const OneStep coarse = one_step(row.integrator, row.step);
+    const OneStep fine = one_step(row.integrator, row.step / 2);
+    ASSERT_TRUE(coarse.has_estimate && fine.has_estimate) << row.integrator;
+    char step_note[32] = "";
+    if (row.step != 0.02) std::snprintf(step_note, sizeof step_note, " (h = %g s)", row.step);
+    std::string halving = "– (adaptive)";
+    if (row.expected_ratio > 0) {
+      char text[48];
+      std::snprintf(text, sizeof text, "%.1f (%d)", coarse.estimate / fine.estimate, row.expected_ratio);
+      halving = text;
+    }
+    table += "| " + std::string(row.integrator) + (row.integrator == std::string("dopri5") ? " (tol 1e-9)" : "") +
+             step_note + " | " + compact_exponent(coarse.estimate, 1) + " | " + compact_exponent(coarse.true_error, 1) +
+             " | " + ratio_as_written(coarse.estimate / coarse.true_error) + " | " + compact_exponent(fine.estimate, 1) +
+             " | " + halving + " |\n";
+  }
+  EXPECT_TRUE(birkhoff_cart_test::docs_part_is_current("docs/accuracy.md", "error_estimate_test", table));
+}
 
 /// `steps` steps of `scene` with the estimate on or off; the states after each step.
 std::vector<CartState> trajectory(Scene scene, bool estimate, int steps, StepStatistics* statistics) {
