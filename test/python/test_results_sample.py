@@ -357,3 +357,20 @@ def test_accuracy_md_quotes_the_tolerance_sweep_page():
             f"{sum(r <= 0.25 for r in values)} of {len(values)}"
         assert shown_matches(stated.group(3), statistics.median(values)), \
             f"{name}: accuracy.md says median {stated.group(3)}; tolerance_sweep.md gives {statistics.median(values):.3f}"
+
+
+def test_the_benchmark_pages_ratios_at_the_goal_are_the_pages():
+    """docs/benchmarks.md's ratios interpolated to exactly 1e-6 m on the 1000 s whirl are the 'at the
+    goal' ratios of results.md's race table (the column of error ≤ 1e-06 m)."""
+    results = (REPO / "docs" / "results.md").read_text()
+    section = results.split("## jackknife_whirl_1000s", 1)[1].split("\n## ", 1)[0]
+    text = re.sub(r"\s+", " ", (REPO / "docs" / "benchmarks.md").read_text())
+    match = re.search(r"interpolated to exactly 1e-6 m the ratio is ([0-9.]+)× \(bulirsch_stoer\) and ([0-9.]+)× \(rkf78\)", text)
+    assert match, "docs/benchmarks.md no longer quotes the whirl's ratios at 1e-6 m"
+    for shown, peer in zip(match.groups(), ("odeint_bulirsch_stoer", "odeint_rkf78")):
+        row = next((line for line in section.splitlines() if line.startswith(f"| `{peer}` |") and "×" in line), None)
+        assert row, f"results.md's jackknife_whirl_1000s race table has no row {peer}"
+        cell = row.split("|")[3]  # | peer | 1e-3 | 1e-6 | ...
+        at_goal = re.search(r"at the goal ([0-9.]+)×", cell)
+        assert at_goal, f"results.md, {peer}, error ≤ 1e-06 m: '{cell.strip()}' has no ratio at the goal"
+        assert shown == at_goal.group(1), f"docs/benchmarks.md says {shown}× against {peer}; results.md: {at_goal.group(1)}×"
