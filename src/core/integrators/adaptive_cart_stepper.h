@@ -84,15 +84,8 @@ class AdaptiveCartStepperAdapter final : public CartStepper {
 
  private:
   static AdaptiveStepSettings control_settings(const IntegratorSettings& settings) {
-    if (!(settings.position_tolerance > 0.0) || !std::isfinite(settings.position_tolerance)) {
-      throw std::invalid_argument("step_control 'adaptive' needs a finite position_tolerance > 0 m, got " +
-                                  std::to_string(settings.position_tolerance));
-    }
-    if (!(settings.tolerance_horizon > 0.0) || !std::isfinite(settings.tolerance_horizon)) {
-      throw std::invalid_argument("integrator.tolerance_horizon must be finite and > 0 s");
-    }
     AdaptiveStepSettings control;
-    control.error_per_unit_step = settings.position_tolerance / settings.tolerance_horizon;  // τ (B.48)
+    control.error_per_unit_step = stepper_checks::error_per_unit_step(settings, "adaptive");
     return control;
   }
 

@@ -79,14 +79,8 @@ class ReversibleCartStepperAdapter final : public CartStepper {
   ReversibleCartStepperAdapter(const Stepper& stepper, const IntegratorSettings& settings, const CartModel& model,
                                const EffectSet& effects)
       : stepper_(stepper), system_(model, effects), transformed_(system_, 0.0, stiff_density_squared(model, effects)),
-        settings_(settings), name_(Stepper::name()), instants_(effects) {
-    if (!(settings.position_tolerance > 0.0) || !std::isfinite(settings.position_tolerance)) {
-      throw std::invalid_argument("step_control 'reversible' needs a finite position_tolerance > 0 m, got " +
-                                  std::to_string(settings.position_tolerance));
-    }
-    if (!(settings.tolerance_horizon > 0.0) || !std::isfinite(settings.tolerance_horizon)) {
-      throw std::invalid_argument("integrator.tolerance_horizon must be finite and > 0 s");
-    }
+        settings_(settings), error_per_unit_step_(stepper_checks::error_per_unit_step(settings, "reversible")),
+        name_(Stepper::name()), instants_(effects) {
     if (effects.depends_on_time()) {
       throw std::invalid_argument(
           "step_control 'reversible' needs loads that do not vary in time (its time transformation reads them at "
@@ -101,7 +95,7 @@ class ReversibleCartStepperAdapter final : public CartStepper {
   void observe_grid(GridObserver observer) override { observer_ = std::move(observer); }
   const std::optional<ReversibleCalibration>& calibration() const { return calibration_; }
   /// τ = position_tolerance / horizon [1/s] (eq. (B.48)).
-  double error_per_unit_step() const { return settings_.position_tolerance / settings_.tolerance_horizon; }
+  double error_per_unit_step() const { return error_per_unit_step_; }
 
   /// The trial grids (ε for the tolerance) from `start`; a tolerance out of reach is a settings
   /// error (std::invalid_argument), not a failed step.
@@ -385,6 +379,7 @@ class ReversibleCartStepperAdapter final : public CartStepper {
   System system_;
   Transformed transformed_;
   IntegratorSettings settings_;
+  double error_per_unit_step_;  ///< τ [1/s]
   std::string name_;
   std::optional<ReversibleCalibration> calibration_;
   std::unique_ptr<Control> control_;
