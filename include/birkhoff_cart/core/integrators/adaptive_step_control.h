@@ -27,7 +27,7 @@
 #include <string>
 
 #include "birkhoff_cart/core/diagnostics.h"
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/integrators/step_error.h"
 #include "birkhoff_cart/core/integrators/compensated_summation.h"
 #include "birkhoff_cart/core/integrators/error_estimate.h"
 
@@ -53,7 +53,9 @@ struct AlwaysPlausible {
   }
 };
 
-/// Counts of a run under the control (also in StepStatistics::rejected_steps).
+/// The error-per-step control of `Stepper` on `System` (file comment): a grid of accepted steps,
+/// carried in `Carried`, with the point before the last step kept for side steps. Rejected attempts
+/// count in StepStatistics::rejected_steps.
 template <class Stepper, class System, class Carried>
 class AdaptiveStepControl {
  public:
@@ -201,9 +203,9 @@ class AdaptiveStepControl {
   }
 
  private:
-  static constexpr int kMaxAttempts = 60;
+  static constexpr int kMaxAttempts = 60;  ///< rejections in a row before giving up (each cuts h to 0.2–0.9 of itself; a failed solve to 0.25)
   /// The round-off floor of ê, a weighted norm relative above 1 SI unit: 64 ε [-].
-  static constexpr double kEstimateRoundOff = 64.0 * std::numeric_limits<double>::epsilon();  ///< rejections in a row before giving up (h shrinks ≥ 5× each)
+  static constexpr double kEstimateRoundOff = 64.0 * std::numeric_limits<double>::epsilon();
   static constexpr int kExponentOrder = Stepper::kErrorEstimateOrder - 1;  ///< ê/h ∝ h^{q−1}
 
   double shrink_factor(double ratio) const {

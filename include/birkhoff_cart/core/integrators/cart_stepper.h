@@ -4,7 +4,6 @@
 
 #include <functional>
 #include <memory>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -13,15 +12,10 @@
 #include "birkhoff_cart/core/effects.h"
 #include "birkhoff_cart/core/integrator_settings.h"
 #include "birkhoff_cart/core/integrators/integrator_registry.h"
+#include "birkhoff_cart/core/integrators/step_error.h"  // StepError, for every user of a CartStepper
 #include "birkhoff_cart/core/state.h"
 
 namespace birkhoff_cart {
-
-/// A step that could not be taken (Newton did not converge, non-finite value, singular matrix).
-class StepError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 /// Advances a CartState by one step of the cart's Birkhoffian system (rep (a) or (b)).
 class CartStepper {

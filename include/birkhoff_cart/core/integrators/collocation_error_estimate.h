@@ -32,7 +32,10 @@ struct LocalErrorVectors {
   PassiveVector<System, S> y = PassiveVector<System, S>::Constant(S(0.0));
 };
 
-/// recorded, or the vectors added to `error_sum`.
+/// The error vectors e = (e_z, e_y) of one collocation step from (z, y) at t [s] over h [s] (eq.
+/// (B.37)): e_w from the stage rates and F(w⁺, tₖ₊₁), mapped to z through the chart, and e_y from
+/// the passive rates at the step's ends and stages. Stores F(w⁺) and g(z⁺, y⁺) in `memory` (first
+/// same as last: the next step's start rates) and counts the evaluations in `statistics`.
 ///
 /// The stage rates are those of the solve's last evaluation, one update before the final Zᵢ: they
 /// are off by about J ΔZ, which moves e by ≲ 4 Σ|ηᵢ| |ΔZ| (h‖J‖ ≲ 4 where the iteration

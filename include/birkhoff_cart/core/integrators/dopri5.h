@@ -48,7 +48,7 @@
 
 #include "birkhoff_cart/core/birkhoffian_system.h"
 #include "birkhoff_cart/core/diagnostics.h"
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/integrators/step_error.h"
 
 namespace birkhoff_cart {
 

@@ -34,7 +34,7 @@
 #include "birkhoff_cart/core/autodiff.h"
 #include "birkhoff_cart/core/birkhoffian_system.h"
 #include "birkhoff_cart/core/diagnostics.h"
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/integrators/step_error.h"
 #include "birkhoff_cart/core/integrators/collocation_error_estimate.h"
 #include "birkhoff_cart/core/integrators/collocation_memory.h"
 #include "birkhoff_cart/core/integrators/compensated_summation.h"
@@ -249,7 +249,8 @@ class GaussCollocation {
     return true;
   }
 
-  /// Keeps the last max(s, 2) stage points (s = 1 keeps two: linear extrapolation of the midpoint rate).
+  /// Keeps the stage points the next step's starting values extrapolate from: s = 1 keeps the last
+  /// three midpoint rates (kPoints, from three steps), s ≥ 2 the s stages of the last step.
   template <class System, class S>
   static void remember(CollocationMemory<System, Stages>& memory, const std::array<double, Stages>& stage_times,
                        const std::array<StateVector<System, S>, Stages>& stage_rates) {

@@ -33,7 +33,7 @@
 #include "birkhoff_cart/core/autodiff.h"
 #include "birkhoff_cart/core/birkhoffian_system.h"
 #include "birkhoff_cart/core/diagnostics.h"
-#include "birkhoff_cart/core/integrators/collocation_failure.h"
+#include "birkhoff_cart/core/integrators/step_error.h"
 #include "birkhoff_cart/core/integrators/collocation_memory.h"
 #include "birkhoff_cart/core/integrators/gauss_legendre_tableau.h"
 #include "birkhoff_cart/core/integrators/kronecker_newton.h"

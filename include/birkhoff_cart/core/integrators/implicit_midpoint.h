@@ -30,7 +30,7 @@
 #include <limits>
 #include <string>
 
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/integrators/step_error.h"
 #include "birkhoff_cart/core/integrators/error_estimate.h"
 #include "birkhoff_cart/core/integrators/integrator_kind.h"
 #include "birkhoff_cart/core/integrators/newton.h"

@@ -34,7 +34,7 @@
 
 #include "birkhoff_cart/core/autodiff.h"
 #include "birkhoff_cart/core/diagnostics.h"
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/integrators/step_error.h"
 
 namespace birkhoff_cart {
 

@@ -16,7 +16,7 @@
 #include "birkhoff_cart/core/autodiff.h"
 #include "birkhoff_cart/core/birkhoffian_system.h"
 #include "birkhoff_cart/core/diagnostics.h"
-#include "birkhoff_cart/core/integrators/collocation_failure.h"
+#include "birkhoff_cart/core/integrators/step_error.h"
 #include "birkhoff_cart/core/integrators/compensated_summation.h"
 #include "birkhoff_cart/core/integrators/gauss_legendre_tableau.h"
 #include "birkhoff_cart/core/integrators/gauss_stage_solver.h"

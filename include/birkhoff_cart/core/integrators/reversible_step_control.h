@@ -25,7 +25,7 @@
 #include <string>
 
 #include "birkhoff_cart/core/diagnostics.h"
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/integrators/step_error.h"
 #include "birkhoff_cart/core/integrators/compensated_summation.h"
 #include "birkhoff_cart/core/integrators/time_transformed_system.h"
 
