@@ -78,6 +78,17 @@
 //       function of z alone (the cart: θ̇), other entries zero, equal to passive_rates' entries bit
 //       for bit; the first d passive sweeps evaluate only these.
 //
+// Optional, read by the step controls (adaptive_step_control.h, reversible_step_control.h; the table
+// of system_traits.h, docs/birkhoffian.md §10.7):
+//
+//   static constexpr std::array<AngleCoordinate, N> kAngleCoordinates;  bool angle_is_periodic(std::size_t k) const;
+//       The coordinates that are angles [rad], carried reduced to (−π, π] with their whole turns apart
+//       while the rates are 2π-periodic in them (the cart: χ and θ; the sleigh: θ). Default: none.
+//   template <class S> S step_density(const Vector<S>& z) const;
+//       σ(z) [1/s], a function of z alone: the reversible control's steps are h ≈ ε/σ. Default 1 s⁻¹.
+//   void begin_step(double t);
+//       Called with the start time t [s] of each step the adaptive control attempts. Default: nothing.
+//
 // The analytic members (K, ∇B, ∂R/∂t, ẇ) are what the integrators use; tests check each against
 // automatic differentiation of R and B (test/unit/structure_checks.h, used by
 // birkhoffian_system_test for the test systems and the cart and by chaplygin_sleigh_test).
@@ -89,6 +100,13 @@
 #include <utility>
 
 namespace birkhoff_cart {
+
+/// An angle among a system's coordinates [rad]: z(index), or y(index) when `passive` (the optional
+/// kAngleCoordinates of a system: system_traits.h).
+struct AngleCoordinate {
+  bool passive = false;
+  int index = 0;
+};
 
 template <class System, class S>
 using StateVector = Eigen::Matrix<S, System::kDimension, 1>;

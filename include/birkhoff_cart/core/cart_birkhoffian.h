@@ -53,6 +53,12 @@ class CartBirkhoffianBase {
   static constexpr int kPassiveCouplingDepth = 1;
   /// Both charts are linear in z (identity; diagonal scaling of p): remainders map through them.
   static constexpr bool kDarbouxChartIsLinear = true;
+  /// χ (angle 0) and θ (angle 1) are angles: a carried point keeps them reduced to (−π, π] with their
+  /// whole turns apart (carried_point.h).
+  static constexpr std::array<AngleCoordinate, 2> kAngleCoordinates{
+      {{false, kSteeringAngleIndex}, {true, kHeadingIndex}}};
+  static constexpr std::size_t kSteeringAngle = 0;  ///< χ's place in kAngleCoordinates
+  static constexpr std::size_t kHeadingAngle = 1;   ///< θ's place in kAngleCoordinates
   template <class S>
   using Vector = Eigen::Matrix<S, kDimension, 1>;
   template <class S>
@@ -66,6 +72,8 @@ class CartBirkhoffianBase {
   const CartModel& model() const { return *model_; }
   /// Are the rates 2π-periodic in χ (no enabled load that grows with χ)?
   bool periodic_in_steering_angle() const { return effects_->periodic_in_steering_angle(); }
+  /// The rates are 2π-periodic in θ always, and in χ unless a load grows with it (a steering spring).
+  bool angle_is_periodic(std::size_t angle) const { return angle != kSteeringAngle || periodic_in_steering_angle(); }
   bool non_birkhoffian_force_enabled() const { return non_birkhoffian_force_enabled_; }
   /// Do the rates change with t at a fixed state (an enabled time profile)?
   bool depends_on_time() const { return non_birkhoffian_force_enabled_ && effects_->depends_on_time(); }

@@ -92,7 +92,7 @@ class AdaptiveCartStepperAdapter final : public CartStepper {
   /// A grid from `state`: the carried point with χ, θ reduced, the first step from the rates there.
   void start(const CartState& state, StepStatistics& statistics) {
     Carried seed;
-    system_.begin_step(state.time);
+    system_traits::begin_step(system_, state.time);
     seed.start_from(system_, state);
     control_.start(seed, state.time, first_step(seed, state.time, statistics));
     dense_.clear();
@@ -135,12 +135,11 @@ class AdaptiveCartStepperAdapter final : public CartStepper {
       if (observer_) observer_(grid_state());
     }
     const Carried& grid = control_.grid();
-    output_.periodic_in_steering_angle = grid.periodic_in_steering_angle;
+    output_.periodic_angles = grid.periodic_angles;
     output_.valid = true;
     if (control_.time() == target) {
       output_.point = grid.point;
-      output_.steering_turns = grid.steering_turns;
-      output_.heading_turns = grid.heading_turns;
+      output_.turns = grid.turns;
     } else if (!(dense_.at(system_, target, output_, statistics) <= position_tolerance_)) {
       side_step(target, statistics);  // where the dense output's own estimate exceeds the tolerance
     }
@@ -150,11 +149,10 @@ class AdaptiveCartStepperAdapter final : public CartStepper {
   /// member's order where the dense output's estimate says it is not.
   void side_step(double target, StepStatistics& statistics) {
     output_.point = control_.previous();
-    output_.steering_turns = control_.previous_steering_turns();
-    output_.heading_turns = control_.previous_heading_turns();
+    output_.turns = control_.previous_turns();
     Memory memory;  // no stage history: an explicit start
     const double start = control_.previous_time();
-    system_.begin_step(start);
+    system_traits::begin_step(system_, start);
     control_.stepper().advance_compensated(system_, output_.point, memory, start, target - start, statistics);
     output_.reduce_angles();
   }
@@ -168,8 +166,7 @@ class AdaptiveCartStepperAdapter final : public CartStepper {
   CartState grid_state() {
     Output grid;
     grid.point = control_.grid().point;
-    grid.steering_turns = control_.grid().steering_turns;
-    grid.heading_turns = control_.grid().heading_turns;
+    grid.turns = control_.grid().turns;
     return grid.output(system_, control_.time());
   }
 

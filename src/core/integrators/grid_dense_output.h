@@ -1,7 +1,8 @@
 // The dense output of a step control's grid for the cart (docs/birkhoffian.md §12.3): the grid
-// points in (z, y) with the angles χ and θ kept on one branch — the whole turns the grid took out of
-// a point are put back relative to the newest point — and their Hermite interpolant
-// (hermite_dense_output.h). Private to the core library.
+// points in (z, y) with the system's angles (χ and θ) kept on one branch — the whole turns the grid
+// took out of a point are put back relative to the newest point — and their Hermite interpolant
+// (hermite_dense_output.h), whose error is estimated on the position (x, y). Private to the core
+// library.
 #pragma once
 
 #include <Eigen/Core>
@@ -10,6 +11,7 @@
 
 #include "birkhoff_cart/core/birkhoffian_system.h"
 #include "birkhoff_cart/core/diagnostics.h"
+#include "birkhoff_cart/core/integrators/carried_point.h"
 #include "birkhoff_cart/core/integrators/hermite_dense_output.h"
 #include "birkhoff_cart/core/integrators/system_traits.h"
 #include "birkhoff_cart/core/state.h"
@@ -28,12 +30,12 @@ class GridDenseOutput {
   void clear() { history_.clear(); }
   int size() const { return history_.size(); }
 
-  /// Adds the grid point of `grid` (a CarriedCartState) at time t [s]; with an identity chart, the
+  /// Adds the grid point of `grid` (a CarriedPoint) at time t [s]; with an identity chart, the
   /// rates its step's local error estimate evaluated there come along (first same as last: no
   /// evaluation later).
   template <class Carried>
   void push(const Carried& grid, double t) {
-    push_point(grid.point, grid.steering_turns, grid.heading_turns, t);
+    push_point(grid.point, grid.turns, t);
     if constexpr (system_traits::kDarbouxChartIsIdentity<System>) {
       const auto& memory = grid.memory;
       if (memory.end_rate_valid && memory.end_time == t) set_newest_rate(memory.end_rate, memory.end_passive_rate);
@@ -43,14 +45,16 @@ class GridDenseOutput {
   /// Adds a grid point (a CompensatedPoint whose z and leading y are the system's; t [s]) with the
   /// turns taken out of its angles.
   template <class Point>
-  void push_point(const Point& point, double steering_turns, double heading_turns, double t) {
+  void push_point(const Point& point, const AngleTurns<System>& turns, double t) {
     // Keep the held points on the newest point's branch: shift them by the turns it took out.
     if (history_.size() > 0) {
-      history_.shift_component(kSteeringAngleIndex, kTwoPi * (steering_turns_ - steering_turns));
-      history_.shift_component(System::kDimension + kHeadingIndex, kTwoPi * (heading_turns_ - heading_turns));
+      constexpr auto angles = system_traits::kAngleCoordinates<System>;
+      for (std::size_t k = 0; k < angles.size(); ++k) {
+        const int component = angles[k].passive ? System::kDimension + angles[k].index : angles[k].index;
+        history_.shift_component(component, kTwoPi * (turns_[k] - turns[k]));
+      }
     }
-    steering_turns_ = steering_turns;
-    heading_turns_ = heading_turns;
+    turns_ = turns;
     Joint x;
     x << point.z + point.z_remainder, (point.y + point.y_remainder).template head<System::kPassiveDimension>();
     history_.push(t, x);
@@ -88,8 +92,7 @@ class GridDenseOutput {
     out.point.y = x.template tail<System::kPassiveDimension>();
     out.point.z_remainder.setZero();
     out.point.y_remainder.setZero();
-    out.steering_turns = steering_turns_;
-    out.heading_turns = heading_turns_;
+    out.turns = turns_;
     return std::hypot(difference(System::kDimension + kXIndex), difference(System::kDimension + kYIndex));
   }
 
@@ -97,8 +100,7 @@ class GridDenseOutput {
   static constexpr double kTwoPi = 6.283185307179586476925286766559;
 
   HermiteDenseOutput<kSize, Points> history_{Points};
-  double steering_turns_ = 0.0;  ///< of the newest point [-]
-  double heading_turns_ = 0.0;   ///< of the newest point [-]
+  AngleTurns<System> turns_{};  ///< of the newest point [-]
 };
 
 }  // namespace birkhoff_cart

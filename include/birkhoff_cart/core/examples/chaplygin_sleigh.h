@@ -37,6 +37,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -81,6 +82,9 @@ class ChaplyginSleigh {
   /// D scales the momenta by e^{γ(t−tₑ)}: linear in z, so compensated summation's remainders map
   /// through it.
   static constexpr bool kDarbouxChartIsLinear = true;
+  /// The heading θ is an angle (the rates are 2π-periodic in it): a step control carries it reduced
+  /// to (−π, π] with its whole turns apart (system_traits.h, carried_point.h).
+  static constexpr std::array<AngleCoordinate, 1> kAngleCoordinates{{{false, kSleighHeading}}};
 
   template <class S>
   using Vector = Eigen::Matrix<S, kDimension, 1>;
@@ -260,6 +264,18 @@ class ChaplyginSleigh {
 
   ChaplyginSleighParameters parameters_;
   bool non_birkhoffian_force_enabled_ = true;
+};
+
+/// The sleigh in its autonomous form (γ = 0): its Darboux chart is the identity, which the reversible
+/// step control's time transformation needs (time_transformed_system.h). Nothing else differs.
+class AutonomousChaplyginSleigh : public ChaplyginSleigh {
+ public:
+  static constexpr bool kDarbouxChartIsIdentity = true;
+  explicit AutonomousChaplyginSleigh(const ChaplyginSleighParameters& parameters = {}) : ChaplyginSleigh(parameters) {
+    if (parameters.conformal_rate != 0.0) {
+      throw std::invalid_argument("AutonomousChaplyginSleigh: conformal_rate must be 0 (the identity chart)");
+    }
+  }
 };
 
 /// The closed-form motion (S.3) of the sleigh from z₀ at t₀ (centre_offset a > 0): z at any t.

@@ -14,6 +14,10 @@
 // landing instant, a kink of the loads (the caller passes them); it is stretched by up to 10 % to
 // land on it rather than leave a sliver.
 //
+// It knows no system beyond the concept (birkhoffian_system.h) and its optional traits
+// (system_traits.h): the system's begin_step(t) before each attempt, its angles carried reduced in
+// the grid (carried_point.h); a caller may add a plausibility check of its own for each attempt.
+//
 // This control is not reversible (h depends on the state at the step's start only): it is for
 // scenes that are not reversible anyway. Free, reversible runs use reversible_step_control.h.
 #pragma once
@@ -25,11 +29,14 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 #include "birkhoff_cart/core/diagnostics.h"
 #include "birkhoff_cart/core/integrators/step_error.h"
+#include "birkhoff_cart/core/integrators/carried_point.h"
 #include "birkhoff_cart/core/integrators/compensated_summation.h"
 #include "birkhoff_cart/core/integrators/error_estimate.h"
+#include "birkhoff_cart/core/integrators/system_traits.h"
 
 namespace birkhoff_cart {
 
@@ -54,8 +61,8 @@ struct AlwaysPlausible {
 };
 
 /// The error-per-step control of `Stepper` on `System` (file comment): a grid of accepted steps,
-/// carried in `Carried`, with the point before the last step kept for side steps. Rejected attempts
-/// count in StepStatistics::rejected_steps.
+/// carried in `Carried` (a CarriedPoint, carried_point.h), with the point before the last step kept
+/// for side steps. Rejected attempts count in StepStatistics::rejected_steps.
 template <class Stepper, class System, class Carried>
 class AdaptiveStepControl {
  public:
@@ -79,23 +86,21 @@ class AdaptiveStepControl {
   /// The grid point before the last accepted step, and its time [s].
   const CompensatedPoint<System>& previous() const { return previous_; }
   double previous_time() const { return previous_time_; }
-  double previous_steering_turns() const { return previous_steering_turns_; }
-  double previous_heading_turns() const { return previous_heading_turns_; }
+  /// The turns of its angles [-] (carried_point.h).
+  const AngleTurns<System>& previous_turns() const { return previous_turns_; }
 
   /// Starts the grid at the carried point of `from` (its point and turns; not its stage history) at
   /// time t [s], with the first step `first_step` [s] (> 0).
   void start(const Carried& from, double t, double first_step) {
     grid_.point = from.point;
-    grid_.steering_turns = from.steering_turns;
-    grid_.heading_turns = from.heading_turns;
-    grid_.periodic_in_steering_angle = from.periodic_in_steering_angle;
+    grid_.turns = from.turns;
+    grid_.periodic_angles = from.periodic_angles;
     grid_.valid = from.valid;
     grid_.memory.clear();
     time_.set(t);
     previous_ = grid_.point;
     previous_time_ = t;
-    previous_steering_turns_ = grid_.steering_turns;
-    previous_heading_turns_ = grid_.heading_turns;
+    previous_turns_ = grid_.turns;
     proposed_step_ = first_step;
     last_error_ratio_ = 0.0;
     last_step_ = 0.0;
@@ -110,11 +115,15 @@ class AdaptiveStepControl {
   /// after as many rejected attempts as it takes. Returns the step taken [s]. Throws StepError
   /// when the step size underflows (a singularity, or a tolerance the member cannot reach there).
   ///
-  /// `plausible(before, after)` (two CompensatedPoints, and the step's start time and size) may
-  /// reject an attempt the estimate accepted — one whose physics is broken (the cart's energy
-  /// balance: a spurious root of the stage equations; the estimate vanishes on linear dynamics).
-  template <class Plausible = AlwaysPlausible>
-  double step(System& system, double limit, StepStatistics& statistics, Plausible plausible = {}) {
+  /// `plausible(before, after, t, h)` (two CompensatedPoints, and the step's start time and size [s]),
+  /// a predicate the caller supplies, may reject an attempt the estimate accepted — one whose physics
+  /// is broken (the cart's energy balance: a spurious root of the stage equations; the estimate
+  /// vanishes on linear dynamics).
+  ///
+  /// `system`: a System, const when it has no begin_step (system_traits.h).
+  template <class SystemRef, class Plausible = AlwaysPlausible>
+  double step(SystemRef& system, double limit, StepStatistics& statistics, Plausible plausible = {}) {
+    static_assert(std::is_same_v<std::remove_const_t<SystemRef>, System>, "the control's own system type");
     const double remaining = time_.until(limit);  // [s]; +inf: no limit
     if (!(remaining > 0.0)) throw std::logic_error("adaptive step control: the limit is not ahead of the grid");
     for (int attempt = 0;; ++attempt) {
@@ -131,7 +140,7 @@ class AdaptiveStepControl {
       grid_.memory.stage_change_limit = settings_.stage_change_fraction * settings_.error_per_unit_step * h;
       bool solved = true;
       try {
-        system.begin_step(time());
+        system_traits::begin_step(system, time());
         stepper_.advance_compensated(system, grid_.point, grid_.memory, time(), h, trial);
       } catch (const StepError&) {
         solved = false;
@@ -152,8 +161,7 @@ class AdaptiveStepControl {
         continue;
       }
       previous_ = saved_point;
-      previous_steering_turns_ = grid_.steering_turns;
-      previous_heading_turns_ = grid_.heading_turns;
+      previous_turns_ = grid_.turns;
       previous_time_ = time();
       grid_.reduce_angles();
       if (lands) {
@@ -188,7 +196,8 @@ class AdaptiveStepControl {
 
   /// Steps until the grid reaches `limit` exactly [s]. Throws StepError beyond
   /// settings().max_steps_per_advance steps.
-  void advance_to(System& system, double limit, StepStatistics& statistics) {
+  template <class SystemRef>
+  void advance_to(SystemRef& system, double limit, StepStatistics& statistics) {
     std::uint64_t steps = 0;
     while (time() < limit) {
       if (++steps > settings_.max_steps_per_advance) {
@@ -241,8 +250,7 @@ class AdaptiveStepControl {
   CompensatedTime time_;         ///< tₙ [s]
   CompensatedPoint<System> previous_;      ///< the point before the last accepted step
   double previous_time_ = 0.0;             ///< [s]
-  double previous_steering_turns_ = 0.0;   ///< its turns [-]
-  double previous_heading_turns_ = 0.0;
+  AngleTurns<System> previous_turns_{};  ///< its turns [-]
   double proposed_step_ = 0.0;   ///< the next attempt's h [s]
   double last_error_ratio_ = 0.0;  ///< ê/(τh) of the last accepted step [-]
   bool ramping_ = false;           ///< the steps after a start are still growing unhindered

@@ -1,51 +1,33 @@
-// What the Birkhoffian collocation members carry from one step to the next (docs/birkhoffian.md §10.4):
-// the point (z, y) with its compensated-summation remainders, the steering angle χ and heading θ
-// reduced to (−π, π] with whole turns kept apart (the cart's rates are 2π-periodic in θ always and in χ
-// unless a steering spring is enabled, so the ulp of χ no longer grows with the turns: at χ ≈ 2262 rad
-// it was 4.5e-13 rad), and the memory of stage derivatives and Newton matrices. The CartState handed
-// out carries each angle as hi + lo (state.h), so that diagnostics keep those bits too.
+// What the cart's adapters carry from one step to the next (docs/birkhoffian.md §10.4): the generic
+// carried point (carried_point.h) of a cart system — the point (z, y) with its compensated-summation
+// remainders, the steering angle χ and heading θ reduced to (−π, π] with whole turns kept apart (the
+// cart's rates are 2π-periodic in θ always and in χ unless a steering spring is enabled, so the ulp of
+// χ no longer grows with the turns: at χ ≈ 2262 rad it was 4.5e-13 rad), and the memory of stage
+// derivatives and Newton matrices — with its translation to and from the CartState. The CartState
+// handed out carries each angle as hi + lo (state.h), so that diagnostics keep those bits too.
 #pragma once
-
-#include <cmath>
-#include <type_traits>
-#include <utility>
 
 #include "birkhoff_cart/core/angle_reduction.h"
 #include "birkhoff_cart/core/cart_birkhoffian.h"
+#include "birkhoff_cart/core/integrators/carried_point.h"
 #include "birkhoff_cart/core/integrators/gauss_collocation.h"
 #include "birkhoff_cart/core/state.h"
 
 namespace birkhoff_cart {
 
-/// Steppers with advance_compensated(system, CompensatedPoint&, CollocationMemory&, t, h, statistics).
-template <class Stepper, class System, class = void>
-struct CarriesStateTrait : std::false_type {};
-template <class Stepper, class System>
-struct CarriesStateTrait<Stepper, System,
-                         std::void_t<decltype(std::declval<const Stepper&>().advance_compensated(
-                             std::declval<const System&>(), std::declval<CompensatedPoint<System>&>(),
-                             std::declval<typename Stepper::template Memory<System>&>(), 0.0, 0.0,
-                             std::declval<StepStatistics&>()))>>
-    : std::true_type {};
-template <class Stepper, class System>
-constexpr bool kCarriesState = CarriesStateTrait<Stepper, System>::value;
-
-/// The memory of a carried state that only hands states out (an adapter's last output).
-struct NoStepMemory {
-  void clear() {}
-};
-
 /// `PointSystem`: the system whose point is carried — System itself, or a system built on it with
 /// the same leading coordinates (the time-transformed system: y with t appended).
 template <class System, class Memory, class PointSystem = System>
-struct CarriedCartState {
-  bool valid = false;
-  CompensatedPoint<PointSystem> point;
-  Memory memory;
-  double steering_turns = 0.0;  ///< whole turns removed from χ [-]
-  double heading_turns = 0.0;   ///< whole turns removed from θ [-]
-  bool periodic_in_steering_angle = true;  ///< rates 2π-periodic in χ (no steering spring)
-  CartState last_output;        ///< what the adapter last handed out
+struct CarriedCartState : CarriedPoint<System, Memory, PointSystem> {
+  using Base = CarriedPoint<System, Memory, PointSystem>;
+  using Base::memory;
+  using Base::point;
+  using Base::turns;
+  using Base::valid;
+  static constexpr std::size_t kSteering = System::kSteeringAngle;  ///< χ's turns in `turns`
+  static constexpr std::size_t kHeading = System::kHeadingAngle;    ///< θ's turns in `turns`
+
+  CartState last_output;  ///< what the adapter last handed out
 
   /// Is `state` exactly the state this carried state produced (every field but the time, bit for
   /// bit)? The time is left out: callers set t = t₀ + n·h themselves (simulation.cpp), which may
@@ -71,26 +53,18 @@ struct CarriedCartState {
     point.z_remainder(kSteeringAngleIndex) = state.steering_angle_low;
     point.y_remainder(kHeadingIndex) = state.heading_low;
     memory.clear();
-    steering_turns = 0.0;
-    heading_turns = 0.0;
-    periodic_in_steering_angle = system.periodic_in_steering_angle();
-    reduce_angles();
+    turns.fill(0.0);
+    this->periodic_angles = system_traits::periodic_angles(system);
+    this->reduce_angles();
     valid = true;
-  }
-
-  void reduce_angles() {
-    if (periodic_in_steering_angle) {
-      reduce_angle(point.z(kSteeringAngleIndex), point.z_remainder(kSteeringAngleIndex), steering_turns);
-    }
-    reduce_angle(point.y(kHeadingIndex), point.y_remainder(kHeadingIndex), heading_turns);
   }
 
   /// The cart state at time t [s], angles unwrapped again as hi + lo; remembered for continues().
   CartState output(const System& system, double t) {
     CartState state = system.to_cart_state(point.z, point.y, t);
-    unwrap_angle(point.z(kSteeringAngleIndex), point.z_remainder(kSteeringAngleIndex), steering_turns,
+    unwrap_angle(point.z(kSteeringAngleIndex), point.z_remainder(kSteeringAngleIndex), turns[kSteering],
                  state.steering_angle, state.steering_angle_low);
-    unwrap_angle(point.y(kHeadingIndex), point.y_remainder(kHeadingIndex), heading_turns, state.heading,
+    unwrap_angle(point.y(kHeadingIndex), point.y_remainder(kHeadingIndex), turns[kHeading], state.heading,
                  state.heading_low);
     last_output = state;
     return state;

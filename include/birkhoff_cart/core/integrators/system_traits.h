@@ -1,6 +1,7 @@
-// What the collocation members read off a Birkhoffian system type beyond the required members of the
-// system concept (birkhoffian_system.h): optional hooks, each detected at compile time, each with a
-// default that is always correct and only slower. docs/birkhoffian.md §10.2–§10.6.
+// What the integrators and the step controls read off a Birkhoffian system type beyond the required
+// members of the system concept (birkhoffian_system.h): optional hooks, each detected at compile
+// time, each with a default that is always correct and only slower or coarser. docs/birkhoffian.md
+// §10.2–§10.7.
 //
 //   hook                                          default            used by
 //   static constexpr unsigned kCyclicMask         0 (none cyclic)    the stop rule (cyclic coordinates do not
@@ -8,14 +9,27 @@
 //                                                                    are zero: kronecker_newton.h)
 //   static constexpr int kPassiveCouplingDepth    −1 (unknown)       the passive quadrature: d + 1 sweeps exact
 //   static constexpr bool kDarbouxChartIsLinear   false              compensated summation through the chart
-//   static constexpr bool kDarbouxChartIsIdentity false              a step's F(w⁺) as ż at its end (dense output)
+//   static constexpr bool kDarbouxChartIsIdentity false              a step's F(w⁺) as ż at its end (dense output);
+//                                                                    the time transformation needs it
 //   darboux_jacobian(w, t)                        forward-mode AD    the simplified-Newton matrix J = ∂ẇ/∂w
 //   darboux_rates_stages(w[s], t[s], F[s])        s calls of ẇ       one call for an iteration's s stages
 //   passive_coupling_rates(z, t)                  the full g         the first d passive sweeps
+//   static constexpr std::array<AngleCoordinate,  none               the carried point (carried_point.h): each
+//     N> kAngleCoordinates                                           angle [rad] kept in (−π, π] with its whole
+//                                                                    turns apart, so its ulp does not grow
+//   bool angle_is_periodic(std::size_t k) const   true               whether the rates are 2π-periodic in angle k
+//                                                                    now (false: it is carried unreduced)
+//   template <class S> S step_density(z) const    1 [1/s]            the reversible control's σ(z) [1/s], eq.
+//                                                                    (B.41): hₙ ≈ ε/σ(zₙ); a function of z alone
+//   void begin_step(double t)                     nothing            called with the start time t [s] of every
+//                                                                    step attempt of the adaptive control and of
+//                                                                    its side steps (the cart's paper form moves
+//                                                                    its structure epoch there)
 #pragma once
 
 #include <Eigen/Core>
 #include <array>
+#include <cstddef>
 #include <type_traits>
 #include <utility>
 
@@ -23,6 +37,7 @@
 #include "birkhoff_cart/core/birkhoffian_system.h"
 
 namespace birkhoff_cart {
+
 namespace system_traits {
 
 namespace detail {
@@ -64,6 +79,37 @@ template <class System>
 struct HasDarbouxJacobian<System, std::void_t<decltype(std::declval<const System&>().darboux_jacobian(
                                       std::declval<const StateVector<System, double>&>(), 0.0))>> : std::true_type {};
 
+template <class System, class = void>
+struct HasAngleCoordinates : std::false_type {};
+template <class System>
+struct HasAngleCoordinates<System, std::void_t<decltype(System::kAngleCoordinates)>> : std::true_type {};
+
+template <class System, class = void>
+struct HasAnglePeriodicity : std::false_type {};
+template <class System>
+struct HasAnglePeriodicity<System, std::void_t<decltype(std::declval<const System&>().angle_is_periodic(
+                                       std::declval<std::size_t>()))>> : std::true_type {};
+
+template <class System, class = void>
+struct HasStepDensity : std::false_type {};
+template <class System>
+struct HasStepDensity<System, std::void_t<decltype(std::declval<const System&>().step_density(
+                                  std::declval<const StateVector<System, double>&>()))>> : std::true_type {};
+
+template <class System, class = void>
+struct HasBeginStep : std::false_type {};
+template <class System>
+struct HasBeginStep<System, std::void_t<decltype(std::declval<System&>().begin_step(0.0))>> : std::true_type {};
+
+template <class System>
+constexpr auto angle_coordinates() {
+  if constexpr (HasAngleCoordinates<System>::value) {
+    return System::kAngleCoordinates;
+  } else {
+    return std::array<AngleCoordinate, 0>{};
+  }
+}
+
 template <class System, int Stages, class = void>
 struct HasStageRates : std::false_type {};
 template <class System, int Stages>
@@ -102,6 +148,52 @@ constexpr bool kHasDarbouxJacobian = detail::HasDarbouxJacobian<System>::value;
 /// The system evaluates ẇ at all s stages of an iteration at once (darboux_rates_stages).
 template <class System, int Stages>
 constexpr bool kHasStageRates = detail::HasStageRates<System, Stages>::value;
+
+/// The angles the system declares (kAngleCoordinates), in its order; none by default.
+template <class System>
+constexpr auto kAngleCoordinates = detail::angle_coordinates<System>();
+
+/// How many angles the system declares [-].
+template <class System>
+constexpr std::size_t kAngleCount = kAngleCoordinates<System>.size();
+
+/// Bit k set: the rates are 2π-periodic in angle k of kAngleCoordinates now (the system's
+/// angle_is_periodic(k); by default every declared angle is).
+template <class System>
+unsigned periodic_angles(const System& system) {
+  unsigned mask = 0u;
+  for (std::size_t k = 0; k < kAngleCount<System>; ++k) {
+    bool periodic = true;
+    if constexpr (detail::HasAnglePeriodicity<System>::value) periodic = system.angle_is_periodic(k);
+    if (periodic) mask |= 1u << k;
+  }
+  return mask;
+}
+
+/// σ(z) [1/s], the step density of the reversible control (eq. (B.41)): the system's step_density(z)
+/// when it has one, else 1 s⁻¹ (constant physical steps h = ε s).
+template <class System, class S>
+S step_density(const System& system, const Eigen::Matrix<S, System::kDimension, 1>& z) {
+  if constexpr (detail::HasStepDensity<System>::value) {
+    return system.step_density(z);
+  } else {
+    static_cast<void>(system);
+    static_cast<void>(z);
+    return S(1.0);
+  }
+}
+
+/// Calls the system's begin_step(t) [s] before a step from t, if it has one (`System` may be const
+/// when it has none).
+template <class System>
+void begin_step(System& system, double t) {
+  if constexpr (detail::HasBeginStep<std::remove_const_t<System>>::value) {
+    system.begin_step(t);
+  } else {
+    static_cast<void>(system);
+    static_cast<void>(t);
+  }
+}
 
 /// J = ∂ẇ/∂w at (w, t): the system's closed form when it has one, else forward-mode AD of ẇ.
 template <class System>

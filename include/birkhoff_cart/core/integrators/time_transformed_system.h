@@ -13,12 +13,12 @@
 //
 // For loads that do not depend on time (the free cart, autonomous drag, springs, dampers, held
 // commands): ẇ is evaluated at the step's start time, which it does not read. The system supplies
-// σ as `step_density(z)` (a function of z alone, any scalar type); its gradient for the Jacobian
-// comes from forward-mode AD.
+// σ as `step_density(z)` (a function of z alone, any scalar type; optional: system_traits.h, default
+// 1 s⁻¹); its gradient for the Jacobian comes from forward-mode AD.
 //
 // The optional hooks of system_traits.h carry over: the cyclic mask (σ must not read a cyclic
 // coordinate either), the passive coupling depth (1/σ reads z alone), the chart's linearity, the
-// stage batch, and the Jacobian J_τ = J/σ − ẇ (∇σ)ᵀ/σ² (∇σ through the chart: the identity chart
+// stage batch, the angles (their indices are the system's: t is appended after its y), and the Jacobian J_τ = J/σ − ẇ (∇σ)ᵀ/σ² (∇σ through the chart: the identity chart
 // here).
 #pragma once
 
@@ -47,6 +47,7 @@ class TimeTransformedSystem {
   static constexpr int kPassiveCouplingDepth = system_traits::kPassiveCouplingDepth<System>;
   static constexpr bool kDarbouxChartIsLinear = system_traits::kDarbouxChartIsLinear<System>;
   static constexpr bool kDarbouxChartIsIdentity = true;
+  static constexpr auto kAngleCoordinates = system_traits::kAngleCoordinates<System>;
   template <class S>
   using Vector = Eigen::Matrix<S, kDimension, 1>;
   template <class S>
@@ -60,13 +61,17 @@ class TimeTransformedSystem {
   TimeTransformedSystem(const System& system, double load_time, double stiff_density_squared = 0.0)
       : system_(&system), load_time_(load_time), stiff_density_squared_(stiff_density_squared) {}
   const System& base() const { return *system_; }
+  /// The base system's periodicity of angle k (system_traits::periodic_angles).
+  bool angle_is_periodic(std::size_t angle) const {
+    return (system_traits::periodic_angles(*system_) >> angle) & 1u;
+  }
 
   /// σ(z) = √(σ_system(z)² + σ_stiff²) [1/s] (eq. (B.44)).
   template <class S>
   S step_density(const Vector<S>& z) const {
     using std::sqrt;
-    if (stiff_density_squared_ == 0.0) return system_->step_density(z);
-    const S base = system_->step_density(z);
+    if (stiff_density_squared_ == 0.0) return system_traits::step_density(*system_, z);
+    const S base = system_traits::step_density(*system_, z);
     return sqrt(base * base + S(stiff_density_squared_));
   }
 
