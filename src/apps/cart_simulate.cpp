@@ -49,8 +49,8 @@
 
 #include "birkhoff_cart/core/accuracy_guard.h"
 #include "birkhoff_cart/core/closest_name.h"
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
-#include "birkhoff_cart/core/integrators/integrator_registry.h"
+#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
+#include "birkhoff_cart/core/cart_binding/integrator_registry.h"
 #include "birkhoff_cart/core/paper_form_drift.h"
 #include "birkhoff_cart/core/run_summary.h"
 #include "birkhoff_cart/core/random_scene.h"

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "birkhoff_cart/core/actuators/steering_end_stops.h"
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/singular_steering.h"
 
 namespace birkhoff_cart {

@@ -11,7 +11,7 @@
 #include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/closest_name.h"
 #include "birkhoff_cart/core/effect_library.h"
-#include "birkhoff_cart/core/integrators/integrator_registry.h"
+#include "birkhoff_cart/core/cart_binding/integrator_registry.h"
 #include "birkhoff_cart/core/step_schedule.h"
 #include "scene_reader.h"
 

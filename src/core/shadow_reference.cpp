@@ -10,7 +10,7 @@
 
 #include "birkhoff_cart/core/birkhoffian_system.h"
 #include "birkhoff_cart/core/cart_birkhoffian.h"
-#include "integrators/cart_joint_rates.h"
+#include "cart_binding/cart_joint_rates.h"
 
 namespace birkhoff_cart {
 namespace {

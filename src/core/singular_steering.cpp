@@ -3,7 +3,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 
 namespace birkhoff_cart {
 namespace {

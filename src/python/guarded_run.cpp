@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/step_schedule.h"
 
 namespace birkhoff_cart {

@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "birkhoff_cart/core/accuracy_guard.h"
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
-#include "birkhoff_cart/core/integrators/integrator_registry.h"
+#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
+#include "birkhoff_cart/core/cart_binding/integrator_registry.h"
 #include "birkhoff_cart/core/run_summary.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/version.h"

@@ -22,7 +22,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
 

@@ -17,7 +17,7 @@
 #include "birkhoff_cart/core/cart_birkhoffian.h"
 #include "birkhoff_cart/core/effect_library.h"
 #include "birkhoff_cart/core/integrators/adaptive_step_control.h"
-#include "birkhoff_cart/core/integrators/carried_state.h"
+#include "birkhoff_cart/core/cart_binding/carried_state.h"
 #include "birkhoff_cart/core/integrators/gauss_collocation.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"

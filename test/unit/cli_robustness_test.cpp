@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "test_scenes.h"
 
 namespace birkhoff_cart {

@@ -13,7 +13,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "test_scenes.h"
 
 namespace {

@@ -20,7 +20,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "birkhoff_cart/core/effect_library.h"
-#include "birkhoff_cart/core/integrators/integrator_registry.h"
+#include "birkhoff_cart/core/cart_binding/integrator_registry.h"
 #include "birkhoff_cart/core/scene.h"
 #include "generated_docs.h"
 #include "test_scenes.h"

@@ -28,7 +28,7 @@
 #include <vector>
 
 #include "birkhoff_cart/core/diagnostics.h"
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/reference_solution.h"
 #include "birkhoff_cart/core/run_summary.h"
 #include "birkhoff_cart/core/scene.h"

@@ -16,7 +16,7 @@
 #include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/effect_library.h"
 #include "birkhoff_cart/core/effects.h"
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/integrators/gauss_legendre_tableau.h"
 #include "birkhoff_cart/core/scene.h"
 #include "generated_docs.h"

@@ -16,7 +16,7 @@
 #include "birkhoff_cart/core/cart_birkhoffian.h"
 #include "birkhoff_cart/core/effect_library.h"
 #include "birkhoff_cart/core/examples/chaplygin_sleigh.h"
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/integrators/integrator_members.h"
 #include "birkhoff_cart/core/scene.h"
 #include "generated_docs.h"

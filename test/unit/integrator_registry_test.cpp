@@ -24,8 +24,8 @@
 
 #include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/effect_library.h"
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
-#include "birkhoff_cart/core/integrators/integrator_registry.h"
+#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
+#include "birkhoff_cart/core/cart_binding/integrator_registry.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
 #include "birkhoff_cart/core/vector_math.h"

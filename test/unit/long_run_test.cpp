@@ -13,7 +13,7 @@
 
 #include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/effects.h"
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/scene.h"
 
 namespace birkhoff_cart {

@@ -15,7 +15,7 @@
 
 #include "birkhoff_cart/core/cart_birkhoffian.h"
 #include "birkhoff_cart/core/integrators/birkhoff_symplectic.h"
-#include "birkhoff_cart/core/integrators/carried_state.h"
+#include "birkhoff_cart/core/cart_binding/carried_state.h"
 #include "birkhoff_cart/core/integrators/reversible_step_control.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/simulation.h"
 

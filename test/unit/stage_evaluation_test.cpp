@@ -14,7 +14,7 @@
 #include <string>
 
 #include "birkhoff_cart/core/cart_birkhoffian.h"
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/vector_math.h"
 #include "generated_docs.h"

@@ -1,5 +1,5 @@
 // The integrator a scene or a caller chooses, with its settings: plain data read by the registry
-// (integrators/integrator_registry.h). Defaults match docs/scenes.md, "integrator".
+// (cart_binding/integrator_registry.h). Defaults match docs/scenes.md, "integrator".
 #pragma once
 
 #include <string>

@@ -17,7 +17,7 @@
 #include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/diagnostics.h"
 #include "birkhoff_cart/core/effects.h"
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/state.h"
 #include "birkhoff_cart/core/step_schedule.h"

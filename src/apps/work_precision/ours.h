@@ -7,7 +7,7 @@
 #include <string>
 
 #include "bench_scene.h"
-#include "birkhoff_cart/core/integrators/integrator_registry.h"
+#include "birkhoff_cart/core/cart_binding/integrator_registry.h"
 #include "birkhoff_cart/core/simulation.h"
 #include "measurement.h"
 

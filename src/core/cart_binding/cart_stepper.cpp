@@ -1,6 +1,6 @@
 // make_cart_stepper: checks the settings every member shares and builds the named member of the
 // registry (integrator_registry.cpp) under the step control the settings ask for.
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 
 #include <cmath>
 #include <stdexcept>

@@ -10,8 +10,8 @@
 
 #include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/effects.h"
-#include "birkhoff_cart/core/integrators/carried_state.h"
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/cart_binding/carried_state.h"
+#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "step_checks.h"
 
 namespace birkhoff_cart {

@@ -23,7 +23,7 @@
 
 #include "birkhoff_cart/core/effects.h"
 #include "birkhoff_cart/core/integrator_settings.h"
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/integrators/dopri5.h"
 #include "cart_joint_rates.h"
 #include "output_instants.h"

@@ -2,7 +2,7 @@
 // from its stepper type, with the factories that turn the member's generic stepper into a
 // CartStepper — at fixed steps, under the reversible or under the adaptive step control — in the
 // Birkhoffian form the settings name.
-#include "birkhoff_cart/core/integrators/integrator_registry.h"
+#include "birkhoff_cart/core/cart_binding/integrator_registry.h"
 
 #include <algorithm>
 #include <cmath>
@@ -14,7 +14,7 @@
 
 #include "birkhoff_cart/core/cart_birkhoffian.h"
 #include "birkhoff_cart/core/closest_name.h"
-#include "birkhoff_cart/core/integrators/carried_state.h"
+#include "birkhoff_cart/core/cart_binding/carried_state.h"
 #include "birkhoff_cart/core/integrators/integrator_members.h"
 #include "adaptive_cart_stepper.h"
 #include "cart_stepper_adapter.h"

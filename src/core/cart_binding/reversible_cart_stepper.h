@@ -30,8 +30,8 @@
 
 #include "birkhoff_cart/core/effects.h"
 #include "birkhoff_cart/core/integrator_settings.h"
-#include "birkhoff_cart/core/integrators/carried_state.h"
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/cart_binding/carried_state.h"
+#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/integrators/reversible_step_control.h"
 #include "birkhoff_cart/core/integrators/time_transformed_system.h"
 #include "grid_dense_output.h"

@@ -12,7 +12,7 @@
 
 #include "birkhoff_cart/core/cart_model.h"
 #include "birkhoff_cart/core/integrator_settings.h"
-#include "birkhoff_cart/core/integrators/cart_stepper.h"
+#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/state.h"
 
 namespace birkhoff_cart {

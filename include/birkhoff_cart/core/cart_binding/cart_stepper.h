@@ -11,7 +11,7 @@
 #include "birkhoff_cart/core/diagnostics.h"
 #include "birkhoff_cart/core/effects.h"
 #include "birkhoff_cart/core/integrator_settings.h"
-#include "birkhoff_cart/core/integrators/integrator_registry.h"
+#include "birkhoff_cart/core/cart_binding/integrator_registry.h"
 #include "birkhoff_cart/core/integrators/step_error.h"  // StepError, for every user of a CartStepper
 #include "birkhoff_cart/core/state.h"
 

@@ -1,5 +1,5 @@
 // The integrator registry: one table of the members (integrator_members.h; the rows are built in
-// src/core/integrators/integrator_registry.cpp) with what each one is and how it is built. Whatever
+// src/core/cart_binding/integrator_registry.cpp) with what each one is and how it is built. Whatever
 // lists, checks or builds a member reads it: the scene loader, make_cart_stepper, cart_simulate's
 // --help, the node, the benchmarks, the tests.
 #pragma once

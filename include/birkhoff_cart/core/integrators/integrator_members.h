@@ -1,7 +1,7 @@
 // The integrator registry's members as types: one line each, the member's generic stepper and a
 // one-line description. This list is the one place a member is added (docs/developing.md, "Adding
 // an integrator"); everything else a row of the registry says is read from the stepper type by the
-// row builder (src/core/integrators/integrator_registry.cpp): its name(), kOrder, kSymmetric, its
+// row builder (src/core/cart_binding/integrator_registry.cpp): its name(), kOrder, kSymmetric, its
 // kind (member_kind), the step controls it takes and whether it evaluates its stages together.
 //
 // The typed tests instantiate from IntegratorMemberTypes (integrator_contract_test and
