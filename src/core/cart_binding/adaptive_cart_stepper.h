@@ -15,72 +15,38 @@
 #pragma once
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
-#include <memory>
-#include <optional>
-#include <set>
-#include <string>
 
+#include "birkhoff_cart/core/cart_binding/carried_state.h"
 #include "birkhoff_cart/core/effects.h"
 #include "birkhoff_cart/core/integrator_settings.h"
 #include "birkhoff_cart/core/integrators/adaptive_step_control.h"
-#include "birkhoff_cart/core/cart_binding/carried_state.h"
-#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
-#include "grid_dense_output.h"
-#include "output_instants.h"
+#include "controlled_cart_stepper.h"
 #include "step_checks.h"
 
 namespace birkhoff_cart {
 
 template <class Stepper, class System>
-class AdaptiveCartStepperAdapter final : public CartStepper {
+class AdaptiveCartStepperAdapter final
+    : public ControlledCartStepper<AdaptiveCartStepperAdapter<Stepper, System>, Stepper, System> {
+  using Base = ControlledCartStepper<AdaptiveCartStepperAdapter<Stepper, System>, Stepper, System>;
+  friend Base;
   using Memory = typename Stepper::template Memory<System>;
   using Carried = CarriedCartState<System, Memory>;
   using Control = AdaptiveStepControl<Stepper, System, Carried>;
-  using Output = CarriedCartState<System, NoStepMemory>;  ///< what was handed out (no stage memory)
-  /// Hermite points: m + 1, m = max(2, p/2), so that the interpolant one point shorter, of the
-  /// member's own order 2m, estimates its error (grid_dense_output.h).
-  static constexpr int kDensePoints = (Stepper::kOrder / 2 > 2 ? Stepper::kOrder / 2 : 2) + 1;
+  using Base::dense_;
+  using Base::instants_;
+  using Base::output_;
+  using Base::system_;
 
  public:
   AdaptiveCartStepperAdapter(const Stepper& stepper, const IntegratorSettings& settings, const CartModel& model,
                              const EffectSet& effects)
-      : system_(model, effects), effects_(&effects), name_(Stepper::name()),
-        control_(stepper, control_settings(settings)), position_tolerance_(settings.position_tolerance),
-        instants_(effects) {}
+      : Base(model, effects, "adaptive"), effects_(&effects), control_(stepper, control_settings(settings)),
+        position_tolerance_(settings.position_tolerance) {}
 
-  const std::string& name() const override { return name_; }
-  int order() const override { return Stepper::kOrder; }
   bool symmetric() const override { return Stepper::kSymmetric; }
-  void land_on(double time) override { instants_.land_on(time); }
-  void observe_grid(GridObserver observer) override { observer_ = std::move(observer); }
-
-  void step(CartState& state, double step_size, StepStatistics& statistics) override {
-    stepper_checks::require_valid_step_size(step_size);
-    const double time = state.time;  // [s]
-    const double target = instants_.target(time, step_size);
-    StepStatistics counted = statistics;
-    counted.newton_iterations_last_step = 0;
-    const bool continues = valid_ && output_.continues(state) && !instants_.commands_changed();
-    valid_ = false;  // on failure: the next step starts afresh from the caller's unchanged state
-    try {
-      if (!continues) start(state, counted);
-      advance(target, counted);
-    } catch (const StepError& error) {
-      throw StepError(name_ + " (adaptive step control): " + error.what());
-    }
-    const auto& point = output_.point;
-    stepper_checks::require_finite_result(name_, time, step_size, point.z, point.y);
-    const CartState next = output_.output(system_, target);
-    stepper_checks::require_finite_speeds(name_, time, step_size, next, point.z);
-    instants_.remember_commands();
-    valid_ = true;
-    ++counted.steps;
-    state = next;
-    statistics = counted;
-  }
 
  private:
   static AdaptiveStepSettings control_settings(const IntegratorSettings& settings) {
@@ -132,7 +98,7 @@ class AdaptiveCartStepperAdapter final : public CartStepper {
         dense_.clear();
       }
       dense_.push(control_.grid(), control_.time());
-      if (observer_) observer_(grid_state());
+      this->notify_grid(control_.grid(), control_.time());
     }
     const Carried& grid = control_.grid();
     output_.periodic_angles = grid.periodic_angles;
@@ -162,25 +128,9 @@ class AdaptiveCartStepperAdapter final : public CartStepper {
     return system_.to_cart_state(point.z + point.z_remainder, point.y + point.y_remainder, t);
   }
 
-  /// The grid's state as a CartState (for the grid observer).
-  CartState grid_state() {
-    Output grid;
-    grid.point = control_.grid().point;
-    grid.turns = control_.grid().turns;
-    return grid.output(system_, control_.time());
-  }
-
-
-  System system_;
   const EffectSet* effects_;
-  std::string name_;
   Control control_;
   double position_tolerance_;  ///< [m]
-  GridDenseOutput<System, kDensePoints> dense_;
-  Output output_;
-  GridObserver observer_;
-  bool valid_ = false;
-  OutputInstants instants_;
 };
 
 }  // namespace birkhoff_cart

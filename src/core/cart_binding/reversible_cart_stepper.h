@@ -20,47 +20,45 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
-#include <memory>
 #include <optional>
-#include <set>
 #include <sstream>
-#include <string>
-#include <vector>
+#include <stdexcept>
 
+#include "birkhoff_cart/core/cart_binding/carried_state.h"
 #include "birkhoff_cart/core/effects.h"
 #include "birkhoff_cart/core/integrator_settings.h"
-#include "birkhoff_cart/core/cart_binding/carried_state.h"
-#include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/integrators/reversible_step_control.h"
 #include "birkhoff_cart/core/integrators/time_transformed_system.h"
-#include "grid_dense_output.h"
-#include "output_instants.h"
+#include "controlled_cart_stepper.h"
 #include "step_checks.h"
 
 namespace birkhoff_cart {
 
 template <class Stepper, class System>
-class ReversibleCartStepperAdapter final : public CartStepper {
+class ReversibleCartStepperAdapter final
+    : public ControlledCartStepper<ReversibleCartStepperAdapter<Stepper, System>, Stepper, System> {
+  using Base = ControlledCartStepper<ReversibleCartStepperAdapter<Stepper, System>, Stepper, System>;
+  friend Base;
   using Transformed = TimeTransformedSystem<System>;
   using Control = ReversibleToleranceControl<Stepper, System>;
   using Grid = typename Control::Grid;
-  using Output = CarriedCartState<System, NoStepMemory>;
+  using Output = typename Base::Output;
   using SideMemory = typename Stepper::template Memory<System>;
-  /// Hermite points: m + 1, m = max(2, p/2), so that the interpolant one point shorter, of the
-  /// member's own order 2m, estimates its error (grid_dense_output.h).
-  static constexpr int kDensePoints = (Stepper::kOrder / 2 > 2 ? Stepper::kOrder / 2 : 2) + 1;
+  using Base::dense_;
+  using Base::instants_;
+  using Base::name_;
+  using Base::output_;
+  using Base::system_;
 
  public:
   static constexpr double kMinFictiveStep = Control::kMinFictiveStep;  ///< ε_min [rad]
 
   ReversibleCartStepperAdapter(const Stepper& stepper, const IntegratorSettings& settings, const CartModel& model,
                                const EffectSet& effects)
-      : system_(model, effects), transformed_(system_, 0.0, stiff_density_squared(model, effects)),
-        settings_(settings), name_(Stepper::name()),
+      : Base(model, effects, "reversible"), transformed_(system_, 0.0, stiff_density_squared(model, effects)),
+        settings_(settings),
         control_(stepper, transformed_, stepper_checks::error_per_unit_step(settings, "reversible"),
-                 settings.tolerance_horizon),
-        instants_(effects) {
+                 settings.tolerance_horizon) {
     if (effects.depends_on_time()) {
       throw std::invalid_argument(
           "step_control 'reversible' needs loads that do not vary in time (its time transformation reads them at "
@@ -68,11 +66,7 @@ class ReversibleCartStepperAdapter final : public CartStepper {
     }
   }
 
-  const std::string& name() const override { return name_; }
-  int order() const override { return Stepper::kOrder; }
   bool symmetric() const override { return true; }
-  void land_on(double time) override { instants_.land_on(time); }
-  void observe_grid(GridObserver observer) override { observer_ = std::move(observer); }
   const std::optional<ReversibleCalibration>& calibration() const { return control_.calibration(); }
   /// τ = position_tolerance / horizon [1/s] (eq. (B.48)).
   double error_per_unit_step() const { return control_.error_per_unit_step(); }
@@ -88,34 +82,6 @@ class ReversibleCartStepperAdapter final : public CartStepper {
       throw std::invalid_argument(name_ + " (reversible step control): " + error.what());
     }
     counted.control_fictive_step = calibration()->fictive_step;
-    statistics = counted;
-  }
-
-  void step(CartState& state, double step_size, StepStatistics& statistics) override {
-    stepper_checks::require_valid_step_size(step_size);
-    const double time = state.time;  // [s]
-    const double target = instants_.target(time, step_size);
-    StepStatistics counted = statistics;
-    counted.newton_iterations_last_step = 0;
-    const bool continues = valid_ && output_.continues(state) && !instants_.commands_changed();
-    valid_ = false;  // on failure: the next step starts afresh from the caller's unchanged state
-    try {
-      if (!calibration()) calibrate(state, counted);
-      counted.control_fictive_step = calibration()->fictive_step;
-      if (!continues) start(state);
-      advance(target, counted);
-    } catch (const StepError& error) {
-      throw StepError(name_ + " (reversible step control): " + error.what());
-    }
-    const auto& point = output_.point;
-    stepper_checks::require_finite_result(name_, time, step_size, point.z, point.y);
-    const CartState next = output_.output(system_, target);
-    stepper_checks::require_finite_speeds(name_, time, step_size, next, point.z);
-    stepper_checks::require_energy_balance(name_, system_.model(), state, next, step_size);
-    instants_.remember_commands();
-    valid_ = true;
-    ++counted.steps;
-    state = next;
     statistics = counted;
   }
 
@@ -145,8 +111,19 @@ class ReversibleCartStepperAdapter final : public CartStepper {
     }
   }
 
+  /// Before a step: ε for the tolerance, once (when prepare() was not called).
+  void before_start(const CartState& state, StepStatistics& statistics) {
+    if (!calibration()) calibrate(state, statistics);
+    statistics.control_fictive_step = calibration()->fictive_step;
+  }
+
+  /// The energy balance of the step (a spurious root of the stage equations breaks it).
+  void check(const CartState& before, const CartState& after, double step_size) const {
+    stepper_checks::require_energy_balance(name_, system_.model(), before, after, step_size);
+  }
+
   /// A grid from `state`: the carried point with χ, θ reduced.
-  void start(const CartState& state) {
+  void start(const CartState& state, StepStatistics& /*statistics*/) {
     Output seed;
     seed.start_from(system_, state);
     control_.start(seed, state.time);
@@ -159,7 +136,7 @@ class ReversibleCartStepperAdapter final : public CartStepper {
   void advance(double target, StepStatistics& statistics) {
     control_.advance_past(target, statistics, [&] {
       push_dense();
-      if (observer_) observer_(grid_state());
+      this->notify_grid(control_.grid(), control_.time());
     });
     output_.periodic_angles = control_.grid().periodic_angles;
     output_.valid = true;
@@ -194,22 +171,9 @@ class ReversibleCartStepperAdapter final : public CartStepper {
     }
   }
 
-  CartState grid_state() {
-    Output grid;
-    grid.take_point(control_.grid());
-    return grid.output(system_, control_.time());
-  }
-
-  System system_;
   Transformed transformed_;
   IntegratorSettings settings_;
-  std::string name_;
   Control control_;
-  GridDenseOutput<System, kDensePoints> dense_;
-  Output output_;
-  GridObserver observer_;
-  bool valid_ = false;
-  OutputInstants instants_;
 };
 
 }  // namespace birkhoff_cart
