@@ -25,7 +25,8 @@
 // e^{−γ(t−tₑ)}.
 //
 // Invariants and closed form (all members are checked against them: test/unit/
-// integrator_contract_test.cpp, k_symplectic_test.cpp, chaplygin_sleigh_test.cpp): the energy
+// integrator_contract_test.cpp, k_symplectic_test.cpp, chaplygin_sleigh_test.cpp; under the step
+// controls, system_step_controls_test.cpp): the energy
 // E = T* is conserved (a quadratic invariant: Gauss collocation keeps it to round-off); with
 // V = √(2E/m), Ω = √(2E/J), λ = m a V / J [1/s] and ω₀ ≠ 0,
 //
