@@ -51,6 +51,7 @@
 #include "birkhoff_cart/core/closest_name.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/cart_binding/integrator_registry.h"
+#include "birkhoff_cart/core/guarded_run.h"
 #include "birkhoff_cart/core/paper_form_drift.h"
 #include "birkhoff_cart/core/run_summary.h"
 #include "birkhoff_cart/core/random_scene.h"
@@ -344,9 +345,8 @@ std::string key_with_option(const std::string& key) {
   return key;
 }
 
-/// One CSV row at `time`, and the accuracy guard's check of the state there.
-void write_row(std::FILE* file, double time, const Simulation& simulation, birkhoff_cart::AccuracyGuard& guard,
-               birkhoff_cart::OdometrySensor* sensor) {
+/// One CSV row at `time` [s].
+void write_row(std::FILE* file, double time, const Simulation& simulation, birkhoff_cart::OdometrySensor* sensor) {
   const CartState& state = simulation.state();
   const birkhoff_cart::CartModel& model = simulation.model();
   std::fprintf(file, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,", time,
@@ -370,7 +370,6 @@ void write_row(std::FILE* file, double time, const Simulation& simulation, birkh
   if (actuators.drive_actuator) std::fprintf(file, ",%.17g", actuators.drive_applied);
   if (actuators.end_stops) std::fprintf(file, ",%d", actuators.end_stop_contact);
   std::fprintf(file, "\n");
-  guard.check(time, simulation.diagnostics(), statistics);
 }
 
 /// At most one line per kProgressPeriod of wall time: percent of scene time, real-time factor.
@@ -431,13 +430,13 @@ int run(int argc, char** argv) {
     return kExitSettings;
   }
 
-  std::unique_ptr<Simulation> simulation;
-  std::uint64_t steps_between_rows = 0;
+  // The run, its accuracy guard checked at the start, at every row's instant and at the end.
+  std::unique_ptr<birkhoff_cart::GuardedRun> guarded_run;
   try {
-    simulation = std::make_unique<Simulation>(scene);
+    guarded_run = std::make_unique<birkhoff_cart::GuardedRun>(scene);
     const std::string drift = birkhoff_cart::paper_form_drift_warning(scene);  // the eᵗ form's h² drift
     if (!drift.empty()) std::fprintf(stderr, "cart_simulate: %s\n", drift.c_str());
-    steps_between_rows = birkhoff_cart::steps_per_interval(1.0 / scene.output_rate, scene.integrator.step_size);
+    guarded_run->require_output_instants_on_steps();
   } catch (const birkhoff_cart::TimeLimitError& error) {
     std::fprintf(stderr, "cart_simulate: scene %s with the given options: key '%s': %s\n", scene.source_path.c_str(),
                  key_with_option(error.key()).c_str(), error.problem().c_str());
@@ -453,59 +452,53 @@ int run(int argc, char** argv) {
     std::fprintf(stderr, "cart_simulate: cannot write '%s': %s\n", output_path.c_str(), std::strerror(errno));
     return kExitSettings;
   }
+  const Simulation& simulation = guarded_run->simulation();
   std::optional<birkhoff_cart::OdometrySensor> sensor;
   if (scene.odometry_sensor) {
-    sensor.emplace(*scene.odometry_sensor, simulation->model());
-    sensor->start(simulation->state(), true);
+    sensor.emplace(*scene.odometry_sensor, simulation.model());
+    sensor->start(simulation.state(), true);
   }
   std::fprintf(file, "t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,local_error_estimate%s%s%s%s\n",
                sensor ? ",odom_x,odom_y,odom_theta,odom_sigma_position,odom_sigma_theta" : "",
                scene.actuators.steering ? ",steering_torque_applied" : "",
                scene.actuators.drive ? ",drive_torque_applied" : "", scene.actuators.end_stops ? ",end_stop_contact" : "");
-  const birkhoff_cart::StepSchedule& schedule = simulation->schedule();
+  const birkhoff_cart::StepSchedule& schedule = simulation.schedule();
   const double start_time = schedule.start_time;  // t0 [s]
-  birkhoff_cart::AccuracyGuard guard(scene.accuracy);
+  const birkhoff_cart::AccuracyGuard& guard = guarded_run->guard();
   ProgressReport progress(!arguments.count("--quiet"), start_time, schedule.end_time);
   std::uint64_t rows = 0;
   const auto write_state = [&](double time) {
-    write_row(file, time, *simulation, guard, sensor ? &*sensor : nullptr);
+    write_row(file, time, simulation, sensor ? &*sensor : nullptr);
     if (std::ferror(file)) throw OutputError(std::string("writing the CSV failed: ") + std::strerror(errno));
     ++rows;
   };
   try {
     write_state(start_time);
-    // Rows at the whole steps n = k m (t0 + k/HZ, m steps per row) and at the run's end t0 + T.
-    while (!simulation->at_end()) {
-      simulation->step_on_schedule();
-      const std::uint64_t n = simulation->steps_taken();
-      const bool output_instant = n <= schedule.whole_steps && n % steps_between_rows == 0;
-      if (output_instant) {
-        write_state(start_time + static_cast<double>(n / steps_between_rows) / scene.output_rate);
-      } else if (simulation->at_end()) {
-        write_state(schedule.end_time);
-      }
-      progress.update(simulation->state().time);
+    // A row at each output instant the run reaches (t0 + k/HZ on the whole steps, and the end t0 + T).
+    while (!simulation.at_end()) {
+      if (const std::optional<double> instant = guarded_run->step()) write_state(*instant);
+      progress.update(simulation.state().time);
     }
   } catch (const OutputError& error) {
     close_output(file);
     std::fprintf(stderr, "cart_simulate: %s at t = %.17g s (%llu rows complete in %s)\n", error.what(),
-                 simulation->state().time, static_cast<unsigned long long>(rows), output_path.c_str());
+                 simulation.state().time, static_cast<unsigned long long>(rows), output_path.c_str());
     return kExitSettings;
   } catch (const std::exception& error) {  // StepError, or anything unexpected: keep the rows
     const bool kept = close_output(file);
     std::fprintf(stderr, "cart_simulate: %s after t = %.17g s (%llu rows %s %s): %s\n",
                  dynamic_cast<const birkhoff_cart::StepError*>(&error) ? "step failed" : "run stopped",
-                 simulation->state().time, static_cast<unsigned long long>(rows),
+                 simulation.state().time, static_cast<unsigned long long>(rows),
                  kept ? "written to" : "NOT all written to", output_path.c_str(), error.what());
-    std::printf("cart_simulate %s", birkhoff_cart::run_summary(*simulation, guard).c_str());
+    std::printf("cart_simulate %s", birkhoff_cart::run_summary(simulation, guard).c_str());
     return kExitStepFailed;
   }
   if (!close_output(file)) {
     std::fprintf(stderr, "cart_simulate: error writing '%s': %s\n", output_path.c_str(), std::strerror(errno));
     return kExitSettings;
   }
-  std::printf("cart_simulate %s", birkhoff_cart::run_summary(*simulation, guard).c_str());
-  if (sensor) std::printf("%s\n", birkhoff_cart::odometry_drift_line(*sensor, simulation->state(), simulation->model()).c_str());
+  std::printf("cart_simulate %s", birkhoff_cart::run_summary(simulation, guard).c_str());
+  if (sensor) std::printf("%s\n", birkhoff_cart::odometry_drift_line(*sensor, simulation.state(), simulation.model()).c_str());
   if (guard.level() == birkhoff_cart::AccuracyLevel::kError) {
     const bool warn_only = arguments.count("--on-accuracy-error") && arguments.at("--on-accuracy-error") == "warn";
     std::fprintf(stderr, "cart_simulate: accuracy %s%s\n", guard.summary().c_str(),

@@ -111,10 +111,9 @@ def _register_code():
     the function submitted: a function passed as an argument would go by reference.)"""
     import cloudpickle
     import birkhoff_cart_study
-    from birkhoff_cart_study import cli_contract, race, task_runner, tasks
-    from birkhoff_cart_study.kinds import cli_runs, random_carts, simulate, work_precision
-    for module in (birkhoff_cart_study, cli_contract, race, task_runner, tasks, simulate, cli_runs, random_carts,
-                   work_precision, sys.modules[__name__]):
+    from birkhoff_cart_study import cli_contract, kinds, race, task_runner, tasks
+    for module in (birkhoff_cart_study, cli_contract, race, task_runner, tasks, *kinds.MODULES,
+                   sys.modules[__name__]):
         cloudpickle.register_pickle_by_value(module)
 
 

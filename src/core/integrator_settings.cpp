@@ -1,8 +1,10 @@
 // The texts of the Birkhoffian forms and step controls (integrator_settings.h): one spelling table
-// per enum, read both ways.
+// per enum, read both ways; the check of a step control's tolerance.
 #include "birkhoff_cart/core/integrator_settings.h"
 
+#include <cmath>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "birkhoff_cart/core/closest_name.h"
@@ -61,5 +63,20 @@ BirkhoffianForm parse_birkhoffian_form(const std::string& text) {
   return parse("birkhoffian_form", text, kFormSpellings);
 }
 StepControl parse_step_control(const std::string& text) { return parse("step_control", text, kControlSpellings); }
+
+void require_position_tolerance(const IntegratorSettings& settings, const std::string& control) {
+  if (!(settings.position_tolerance > 0.0) || !std::isfinite(settings.position_tolerance)) {
+    throw std::invalid_argument("step_control '" + control + "' needs a finite position_tolerance > 0 m, got " +
+                                std::to_string(settings.position_tolerance));
+  }
+  if (!(settings.tolerance_horizon > 0.0) || !std::isfinite(settings.tolerance_horizon)) {
+    throw std::invalid_argument("integrator.tolerance_horizon must be finite and > 0 s");
+  }
+}
+
+double error_per_unit_step(const IntegratorSettings& settings, const std::string& control) {
+  require_position_tolerance(settings, control);
+  return settings.position_tolerance / settings.tolerance_horizon;
+}
 
 }  // namespace birkhoff_cart

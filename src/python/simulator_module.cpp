@@ -1,6 +1,6 @@
 // birkhoff_cart.simulator: the simulator as a Python module (pybind11, numpy). It translates only:
 // scenes come through the core's scene reader (scene_source.h), runs through GuardedRun
-// (guarded_run.h: a Simulation with cart_simulate's accuracy guard), and the arrays it returns are
+// (core/guarded_run.h: the run loop with its accuracy guard that cart_simulate and cart_sim share), and the arrays it returns are
 // the core's CartState, Diagnostics and guard values in SI units. The long loops (a batch of steps,
 // a run, a time grid) run in C++ with the GIL released, so a Python loop that advances many steps per
 // call pays the crossing once. docs/python.md.
@@ -21,7 +21,7 @@
 #include "birkhoff_cart/core/run_summary.h"
 #include "birkhoff_cart/core/scene.h"
 #include "birkhoff_cart/core/version.h"
-#include "guarded_run.h"
+#include "birkhoff_cart/core/guarded_run.h"
 #include "scene_source.h"
 
 namespace py = pybind11;

@@ -67,6 +67,13 @@ std::array<double, 6> read_variances(const ros::NodeHandle& node, const std::str
 
 }  // namespace
 
+void apply_integrator_overrides(const CartSimParameters& parameters, IntegratorSettings& settings) {
+  if (!parameters.integrator.empty()) settings.name = parameters.integrator;
+  if (parameters.step_size > 0.0) settings.step_size = parameters.step_size;
+  if (!parameters.step_control.empty()) settings.step_control = parse_step_control(parameters.step_control);
+  if (parameters.position_tolerance > 0.0) settings.position_tolerance = parameters.position_tolerance;
+}
+
 std::string format_seconds(double value) {
   std::ostringstream text;
   text << std::setprecision(10) << value;

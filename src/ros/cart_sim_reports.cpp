@@ -34,6 +34,24 @@ CartSimReports::CartSimReports(const RunView& run, ros::NodeHandle& node, ros::N
   diagnostics_listeners_ = node.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 1);
 }
 
+void CartSimReports::log_start() const {
+  const StepControl control = run_.simulation.scene().integrator.step_control;
+  const std::string step_control = control == StepControl::kFixed
+                                       ? ""
+                                       : std::string(" (") + to_string(control) + " step control for " +
+                                             format_seconds(run_.simulation.scene().integrator.position_tolerance) +
+                                             " m; h is the output step)";
+  ROS_INFO("cart_sim: scene '%s' (%s), integrator %s, h = %g s%s, %s mode%s, publish %g Hz, end t = %s s, frames %s -> "
+           "%s, %s%s%s",
+           run_.simulation.scene().name.c_str(), run_.parameters.scene_path.c_str(), run_.simulation.integrator_name().c_str(),
+           run_.simulation.step_size(), step_control.c_str(), run_.parameters.fast ? "fast" : "real-time", run_.parameters.lockstep ? ", lockstep" : "",
+           run_.parameters.publish_rate, format_seconds(run_.timeline.end_time()).c_str(), run_.parameters.frames.odom.c_str(),
+           run_.parameters.frames.base_link.c_str(),
+           run_.parameters.publish_clock ? "publishing /clock"
+                                     : (run_.parameters.follow_clock ? "following /clock" : "not publishing /clock"),
+           run_.record ? ", recording to " : "", run_.record ? run_.record->bag().path().c_str() : "");
+}
+
 void CartSimReports::publish_diagnostics() {
   // Without a subscriber roscpp drops the status, so it is not built (some 30 µs: forty values
   // turned into text, once per ~diagnostic_period). The rejections it would have reported count as
@@ -122,6 +140,22 @@ void CartSimReports::report_progress() {
   }
 }
 
+
+std::string CartSimReports::report_stop(const std::string& outcome,
+                                        const std::optional<std::string>& internal_error) {
+  std::string result = outcome;
+  const double time = run_.simulation.state().time;  // [s]
+  if (run_.step_failure) {
+    ROS_ERROR("cart_sim: step failed at t = %.9g s: %s", time, run_.step_failure->c_str());
+    result = "step failure: " + *run_.step_failure;
+    publish_diagnostics();
+  }
+  if (internal_error) {
+    ROS_FATAL("cart_sim: stopped at t = %.9g s by an unexpected error: %s", time, internal_error->c_str());
+    result = "internal error: " + *internal_error;
+  }
+  return result;
+}
 
 void CartSimReports::write_summary(const std::string& outcome) {
   const CartState& state = run_.simulation.state();

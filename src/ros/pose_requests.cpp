@@ -129,4 +129,15 @@ void PoseRequests::on_initial_pose(const geometry_msgs::PoseWithCovarianceStampe
   teleport_(target, initial_pose_subscriber_.getTopic(), text);
 }
 
+std::string PoseRequests::teleported(const std::string& source, const Simulation& simulation, const CartState& target,
+                                     bool recording) {
+  const Eigen::Vector2d base = simulation.model().rear_axle_midpoint(target);
+  std::ostringstream text;
+  text << source << ": teleported at t = " << format_seconds(simulation.state().time) << " s to base_link ("
+       << base.x() << ", " << base.y() << ") m, heading " << target.heading << " rad, steering angle "
+       << target.steering_angle << " rad, forward speed " << target.forward_speed << " m/s, steering rate "
+       << target.steering_rate << " rad/s (a restart of the run from there" << (recording ? "; the bag goes on)" : ")");
+  return text.str();
+}
+
 }  // namespace birkhoff_cart

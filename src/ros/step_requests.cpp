@@ -106,4 +106,13 @@ void StepRequests::end(double time, bool shutdown) {
   condition_.notify_all();
 }
 
+StepRequests::Refusal StepRequests::node_refusal(const CartSimParameters& parameters, const std::atomic<bool>& paused) {
+  return [&parameters, &paused]() -> std::string {
+    if (parameters.lockstep) return "~lockstep is on: the controllers' answers pace the run";
+    if (parameters.follow_clock) return "~follow_clock is on: the leader's /clock paces the run";
+    if (!paused) return "the run is not paused (call ~pause with data: true first)";
+    return "";
+  };
+}
+
 }  // namespace birkhoff_cart

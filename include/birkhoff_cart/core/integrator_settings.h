@@ -52,4 +52,13 @@ struct IntegratorSettings {
   double tolerance_horizon = 0.0;   ///< reversible: the time position_tolerance is for [s]; 0: the scene's duration
 };
 
+/// The one check of a step control's tolerance: std::invalid_argument naming the setting when
+/// position_tolerance [m] or tolerance_horizon [s] is not finite and > 0 ("step_control 'adaptive'
+/// needs a finite position_tolerance > 0 m, got 0.000000"). `control`: the control's text.
+void require_position_tolerance(const IntegratorSettings& settings, const std::string& control);
+
+/// τ = position_tolerance / tolerance_horizon [1/s] (eq. (B.48)): the error per unit step that step
+/// control `control` ("adaptive", "reversible") allows, after require_position_tolerance.
+double error_per_unit_step(const IntegratorSettings& settings, const std::string& control);
+
 }  // namespace birkhoff_cart

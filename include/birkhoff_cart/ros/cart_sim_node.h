@@ -15,14 +15,17 @@
 //    every expected command topic has answered (or ~lockstep_timeout), and callbacks run only
 //    there, so a closed loop through another node is the same on every run.
 //
-// Parts with a job of their own are classes: CommandInputs (the command topics, their watchdogs and
-// the lockstep answers), StepRequests (~step on its own threads), RunRecord (the bag of each run and
-// its failure), RunWorkMeter (what the run costs in wall time), RunTimeline (where the run starts
-// and ends, and the ROS-time rules), InstantPublisher (the topics of a publish instant, /clock and
-// tf, and what of them goes into the bag), CartSimReports (/diagnostics, the progress lines, the
-// summary), PoseRequests (~set_state and initialpose), RunSettings (what dynamic_reconfigure may
-// change while running). Every restart of the run (~reset, ~set_state, initialpose, a follower
-// moved onto its leader's clock) goes through restart_run().
+// Parts with a job of their own are classes: GuardedRun (the core's run: the simulation and its
+// accuracy guard), PublishSchedule (the publish and /diagnostics instants), RunPacing (real-time
+// deadlines, pauses, a leader's /clock), LockstepBarrier (the lockstep waits), CommandInputs (the
+// command topics, their watchdogs and the lockstep answers), StepRequests (~step on its own
+// threads), RunRecord (the bag of each run and its failure), RunWorkMeter (what the run costs in
+// wall time), RunTimeline (where the run starts and ends, and the ROS-time rules), InstantPublisher
+// (the topics of a publish instant, /clock and tf, and what of them goes into the bag),
+// CartSimReports (/diagnostics, the progress lines, the start line, the summary), PoseRequests
+// (~set_state and initialpose), RunSettings (what dynamic_reconfigure may change while running).
+// Every restart of the run (~reset, ~set_state, initialpose, a follower moved onto its leader's
+// clock) goes through restart_run().
 #pragma once
 
 #include <atomic>
@@ -42,10 +45,9 @@
 #include <std_msgs/Float64.h>
 #include <std_srvs/Empty.h>
 #include <std_srvs/SetBool.h>
-#include <rosgraph_msgs/Clock.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include "birkhoff_cart/core/accuracy_guard.h"
+#include "birkhoff_cart/core/guarded_run.h"
 #include "birkhoff_cart/SetCartState.h"
 #include "birkhoff_cart/core/sensors/odometry_sensor.h"
 #include "birkhoff_cart/core/simulation.h"
@@ -56,11 +58,14 @@
 #include "birkhoff_cart/ros/command_inputs.h"
 #include "birkhoff_cart/ros/conversions.h"
 #include "birkhoff_cart/ros/instant_publisher.h"
+#include "birkhoff_cart/ros/lockstep_barrier.h"
 #include "birkhoff_cart/ros/pose_requests.h"
+#include "birkhoff_cart/ros/run_pacing.h"
 #include "birkhoff_cart/ros/run_settings.h"
 #include "birkhoff_cart/ros/shutdown_signals.h"
 #include "birkhoff_cart/ros/signaling_callback_queue.h"
 #include "birkhoff_cart/ros/step_requests.h"
+#include "birkhoff_cart/core/node_logic/instant_schedule.h"
 #include "birkhoff_cart/core/node_logic/run_timeline.h"
 #include "birkhoff_cart/core/node_logic/wall_clock_pacing.h"
 
@@ -92,7 +97,7 @@ class CartSimNode {
   /// Asks run() to end as at a shutdown signal (thread-safe): the nodelet's unload.
   void request_stop() { stop_flag_ = true; }
 
-  const Simulation& simulation() const { return *simulation_; }
+  const Simulation& simulation() const { return run_->simulation(); }
   const CartSimParameters& parameters() const { return parameters_; }
 
  private:
@@ -137,66 +142,38 @@ class CartSimNode {
   /// One publish instant: the guard checked, the state published and recorded, /diagnostics when due.
   void publish_instant();
 
-  /// Runs the queued callbacks (commands, services) now.
-  void process_callbacks();
-  /// Real-time mode: sleeps until scene time `time` [s] is due or a message arrives; runs the
-  /// callbacks of an arrival. True when `time` is due.
-  bool wait_until_due(double time);
-  /// Paused: waits for a message (~pause, ~reset) or 0.1 s; counts the paused wall time.
-  void wait_while_paused();
-  /// Lockstep: after publishing instant `time` [s], waits for every expected command topic.
-  void wait_for_commands(double time);
-  /// Lockstep, before the first step: waits until every expected command topic has a publisher
-  /// and joint_states a subscriber (a state published before would be lost and its barrier time out).
-  void wait_for_controllers();
   bool stop_requested() const;
-  /// ~follow_clock: waits until the /clock another node drives reaches scene time `time` [s] (the
-  /// end of the next batch of steps), so this cart's stamps are instants of that clock, never ahead.
-  void wait_for_clock(double time);
   /// ~follow_clock, at the start of a whole run: once a /clock is heard, moves the run's start onto
   /// the leader's clock (start_on_leader_clock) instead of replaying the leader's past in a burst.
   /// True when the start moved (a new batch begins).
   bool start_on_leader_clock_if_behind();
-  /// /clock from the leader (~follow_clock): this process's ROS time; a clock that goes back (the
-  /// leader was reset) is noted for the loop, which resets this cart too.
-  void hear_clock(const rosgraph_msgs::Clock::ConstPtr& clock);
 
   ros::NodeHandle node_;
   ros::NodeHandle private_node_;
   SignalingCallbackQueue callback_queue_;  ///< every subscription and service of the node
   CartSimParameters parameters_;
-  std::unique_ptr<Simulation> simulation_;
-  AccuracyGuard accuracy_guard_;  ///< scene `accuracy` + ~accuracy/...; checked at every publish instant
+  /// The simulation and its accuracy guard (scene `accuracy` + ~accuracy/...), checked at every publish instant.
+  std::unique_ptr<GuardedRun> run_;
   std::optional<CommandInputs> commands_;  ///< steering_torque, drive_torque: channels, watchdogs, lockstep answers
   std::optional<RunRecord> record_;  ///< the bag of each run; none without ~bag_path
 
   std::optional<InstantPublisher> publisher_;  ///< the topics of a publish instant, /clock, tf
   /// The scene's odometry sensor (docs/odometry_sensor.md); none: odom is the exact state.
   std::optional<OdometrySensor> odometry_sensor_;
-  ros::Subscriber clock_subscriber_;  ///< /clock from elsewhere when ~publish_clock is false
   ros::ServiceServer reset_service_;
   ros::ServiceServer pause_service_;
   std::optional<PoseRequests> pose_requests_;  ///< ~set_state and initialpose, teleporting through teleport()
   std::unique_ptr<StepRequests> step_requests_;  ///< ~step, on threads of its own
   std::optional<RunSettings> settings_;  ///< what dynamic_reconfigure may change while running
+  std::optional<LockstepBarrier> lockstep_;  ///< the waits for the controllers (~lockstep)
 
   std::optional<RunTimeline> timeline_;   ///< where the run started and stops, the ROS-time rules
-  double publish_period_ = 0.01;          ///< [s]
-  WallClockPacing pacing_;
-  std::uint64_t next_publish_index_ = 1;  ///< k of the next publish instant t0 + k/publish_rate
-  std::uint64_t next_diagnostic_index_ = 1;
-  bool clock_started_ = false;            ///< the first /clock (t0 + h) went out
+  std::optional<RunPacing> pacing_;  ///< real-time deadlines, pauses, a leader's /clock
+  std::optional<PublishSchedule> instants_;  ///< the publish and /diagnostics instants, the first /clock
   std::atomic<bool> paused_{false};  ///< read by the ~step thread
   std::atomic<bool> stop_flag_{false};  ///< request_stop()
   std::uint64_t restarts_ = 0;            ///< restarts of the run (~reset, teleports, a follower's move)
-  /// ~follow_clock: a whole run waits to start on the leader's clock, catching up at most this lag
-  /// [s] by stepping (start_on_leader_clock); none: it has started.
-  std::optional<double> start_catch_up_;
-  bool leader_clock_went_back_ = false;  ///< ~follow_clock: the leader's /clock went back (heard on the loop's thread)
-  double leader_clock_before_ = 0.0;      ///< the leader's /clock before it went back [s]
   std::optional<std::string> step_failure_;
-
-  std::uint64_t lockstep_timeouts_ = 0;  ///< lockstep instants that went on without every answer
 
   RunWorkMeter work_;  ///< wall time of the run: integration_error, diagnostics, progress, summary
   /// /diagnostics, progress lines, the summary; last, since it reads the members above.

@@ -8,6 +8,7 @@
 
 #include <ros/node_handle.h>
 
+#include "birkhoff_cart/core/integrator_settings.h"
 #include "birkhoff_cart/ros/conversions.h"
 
 namespace birkhoff_cart {
@@ -54,6 +55,10 @@ const std::vector<std::string>& cart_sim_parameter_names();
 
 /// Reads and validates every private parameter. Throws std::invalid_argument naming the first bad one.
 CartSimParameters load_parameters(const ros::NodeHandle& private_node);
+
+/// The integrator settings the parameters override (~integrator, ~step_size, ~step_control,
+/// ~position_tolerance), each when given.
+void apply_integrator_overrides(const CartSimParameters& parameters, IntegratorSettings& settings);
 
 /// `value` [s] with 10 significant digits, for log lines and service answers.
 std::string format_seconds(double value);

@@ -43,12 +43,18 @@ class CartSimReports {
   /// /diagnostics through a diagnostic_updater on `node` (its parameters under `private_node`).
   CartSimReports(const RunView& run, ros::NodeHandle& node, ros::NodeHandle& private_node);
 
+  /// The node's start line: scene, integrator and step, mode, publish rate, end, frames, clock, bag.
+  void log_start() const;
   /// Publishes the /diagnostics status now (the node calls it every ~diagnostic_period of scene
   /// time); builds it only when someone subscribes.
   void publish_diagnostics();
   /// Fast mode: at most once per second of wall time, one log line with the scene time, the percent
   /// of the run done and the real-time factor since the last line.
   void report_progress();
+  /// The error lines of a run stopped by a failed step (with its /diagnostics) or by an unexpected
+  /// `internal_error`; returns the outcome then ("step failure: ...", "internal error: ...";
+  /// `outcome` when neither).
+  std::string report_stop(const std::string& outcome, const std::optional<std::string>& internal_error);
   /// The summary paragraph of a run that ended with `outcome` ("finished", "step failure: ...").
   void write_summary(const std::string& outcome);
   /// Someone subscribes to /diagnostics.

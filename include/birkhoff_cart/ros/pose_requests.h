@@ -32,6 +32,11 @@ class PoseRequests {
   PoseRequests(ros::NodeHandle& node, ros::NodeHandle& private_node, const CartSimParameters& parameters,
                const Simulation& simulation, Teleport teleport);
 
+  /// The message of a teleport by `source` to `target` done at the simulation's time: base_link's
+  /// position [m], heading, steering angle [rad], speeds; `recording`: the bag goes on.
+  static std::string teleported(const std::string& source, const Simulation& simulation, const CartState& target,
+                                bool recording);
+
  private:
   bool on_set_state(SetCartState::Request& request, SetCartState::Response& response);
   void on_initial_pose(const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& message);

@@ -20,6 +20,7 @@
 #include <ros/spinner.h>
 
 #include "birkhoff_cart/StepRun.h"
+#include "birkhoff_cart/ros/cart_sim_parameters.h"
 
 namespace birkhoff_cart {
 
@@ -32,6 +33,9 @@ class StepRequests {
   /// Why a ~step request is refused now ("" when it is not): the node's own conditions (lockstep,
   /// following /clock, not paused). Called on the service's threads.
   using Refusal = std::function<std::string()>;
+  /// The refusal of cart_sim in the mode of `parameters`: ~lockstep and ~follow_clock pace the run
+  /// themselves; otherwise it must be `paused` first. Both outlive the refusal.
+  static Refusal node_refusal(const CartSimParameters& parameters, const std::atomic<bool>& paused);
 
   /// Advertises ~step on `private_node` with a queue and two threads of its own; `wake` wakes the
   /// run loop when steps are requested; `time` [s]: the scene time at the start.

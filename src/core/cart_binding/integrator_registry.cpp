@@ -91,13 +91,7 @@ std::unique_ptr<CartStepper> adaptive_step(const IntegratorSettings& settings, c
 /// tolerance per second of the horizon (dopri5_cart_stepper.h).
 std::unique_ptr<CartStepper> adaptive_dopri5(const IntegratorSettings& settings, const CartModel& model,
                                              const EffectSet& effects) {
-  if (!(settings.position_tolerance > 0.0) || !std::isfinite(settings.position_tolerance)) {
-    throw std::invalid_argument("step_control 'adaptive' needs a finite position_tolerance > 0 m, got " +
-                                std::to_string(settings.position_tolerance));
-  }
-  if (!(settings.tolerance_horizon > 0.0) || !std::isfinite(settings.tolerance_horizon)) {
-    throw std::invalid_argument("integrator.tolerance_horizon must be finite and > 0 s");
-  }
+  require_position_tolerance(settings, to_string(StepControl::kAdaptive));
   // A tenth of the position tolerance per second of the horizon: measured on the shipped scenes, the
   // delivered error then stays within 10× of the tolerance (the default scene's 60 s came closest).
   const double per_step = 0.1 * settings.position_tolerance / settings.tolerance_horizon;  // [-]

@@ -38,19 +38,7 @@ inline void require_valid_step_size(double step_size) {
   }
 }
 
-/// τ = position_tolerance / tolerance_horizon [1/s] (eq. (B.48)): the error per unit step that step
-/// control `control` ("adaptive", "reversible") allows; a tolerance or a horizon that is not finite
-/// and > 0 is refused by name.
-inline double error_per_unit_step(const IntegratorSettings& settings, const std::string& control) {
-  if (!(settings.position_tolerance > 0.0) || !std::isfinite(settings.position_tolerance)) {
-    throw std::invalid_argument("step_control '" + control + "' needs a finite position_tolerance > 0 m, got " +
-                                std::to_string(settings.position_tolerance));
-  }
-  if (!(settings.tolerance_horizon > 0.0) || !std::isfinite(settings.tolerance_horizon)) {
-    throw std::invalid_argument("integrator.tolerance_horizon must be finite and > 0 s");
-  }
-  return settings.position_tolerance / settings.tolerance_horizon;
-}
+using ::birkhoff_cart::error_per_unit_step;  // the settings' own check (integrator_settings.h)
 
 [[noreturn]] inline void throw_non_finite(const std::string& integrator, double time, double step_size,
                                    const std::string& quantity, double value) {

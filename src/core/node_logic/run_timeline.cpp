@@ -37,6 +37,16 @@ RunTimeline::RunTimeline(double duration_parameter, double scene_duration, doubl
   start_at(start_time);
 }
 
+std::string RunTimeline::refusal_to_start_at(double start_time) const {
+  RunTimeline moved = *this;
+  try {
+    moved.start_at(start_time);
+  } catch (const RunTimelineError& error) {
+    return error.what();
+  }
+  return "";
+}
+
 void RunTimeline::start_at(double start_time) {
   // Scene time t is ROS time t, and ROS time cannot be negative: refused here, not at the first
   // /clock (which would end the run in std::terminate with the bag left unfinished).

@@ -34,6 +34,8 @@ class RunTimeline {
   /// A whole run from `start_time` [s]: from the scene's t0, or (a follower) from its leader's
   /// clock. Throws RunTimelineError naming the problem, with nothing changed.
   void start_at(double start_time);
+  /// Why start_at(`start_time`) would refuse (its message); "" when it would not. Nothing changes.
+  std::string refusal_to_start_at(double start_time) const;
 
   /// T, the length of a whole run [s]; +inf: without end.
   double duration() const { return duration_; }

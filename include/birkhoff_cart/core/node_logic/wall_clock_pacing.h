@@ -16,6 +16,14 @@ class WallClockPacing {
   /// `factor` [-]: scene seconds per wall second; 0 = unpaced (as fast as possible).
   explicit WallClockPacing(double factor = 0.0) : factor_(factor) {}
 
+  /// Longest single sleep of cart_sim's waits [s of wall time]: a SIGINT/SIGTERM (whose handler
+  /// cannot wake a condition) is seen within this time.
+  static constexpr double kLongestSleep = 0.1;
+  /// The wall instant `seconds` [s] from now.
+  static Clock::time_point after(double seconds) {
+    return Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+  }
+
   bool paced() const { return factor_ > 0.0; }
   double factor() const { return factor_; }
 

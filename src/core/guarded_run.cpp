@@ -1,5 +1,5 @@
-// GuardedRun (guarded_run.h): the Simulation and accuracy guard the Python module drives.
-#include "guarded_run.h"
+// GuardedRun (guarded_run.h): a simulation run to its output instants with its accuracy guard.
+#include "birkhoff_cart/core/guarded_run.h"
 
 #include <cmath>
 #include <sstream>
@@ -10,37 +10,50 @@
 #include "birkhoff_cart/core/step_schedule.h"
 
 namespace birkhoff_cart {
-namespace python {
 
-GuardedRun::GuardedRun(const Scene& scene) : simulation_(scene), guard_(scene.accuracy) {
+GuardedRun::GuardedRun(const Scene& scene, OutputInstants instants)
+    : simulation_(scene), guard_(scene.accuracy), instants_(instants) {
   try {
     steps_between_checks_ = steps_per_interval(1.0 / scene.output_rate, scene.integrator.step_size);
     checks_at_output_instants_ = true;
   } catch (const std::invalid_argument&) {
     steps_between_checks_ = 1;  // output interval no whole number of steps: check after every step
   }
-  guard_.check(simulation_.schedule().start_time, simulation_.diagnostics(), simulation_.statistics());
+  check_start();
 }
 
-void GuardedRun::check_if_due() {
-  // As cart_simulate checks its rows: at the output instants t₀ + k/rate among the whole steps, and
-  // at the run's end.
+void GuardedRun::require_output_instants_on_steps() const {
+  const Scene& scene = simulation_.scene();
+  steps_per_interval(1.0 / scene.output_rate, scene.integrator.step_size);
+}
+
+void GuardedRun::check_start() {
+  if (instants_ == OutputInstants::kOutputRate) check(simulation_.schedule().start_time);
+}
+
+void GuardedRun::check(double time) { check(time, simulation_.diagnostics()); }
+
+void GuardedRun::check(double time, const Diagnostics& diagnostics) {
+  guard_.check(time, diagnostics, simulation_.statistics());
+}
+
+std::optional<double> GuardedRun::step() {
+  simulation_.step_on_schedule();
+  if (instants_ != OutputInstants::kOutputRate) return std::nullopt;
+  // The output instants t₀ + k/rate among the whole steps, and the run's end.
   const StepSchedule& schedule = simulation_.schedule();
   const std::uint64_t n = simulation_.steps_taken();
+  std::optional<double> instant;
   if (n <= schedule.whole_steps && n % steps_between_checks_ == 0) {
     const double rate = simulation_.scene().output_rate;  // [Hz]
-    const double time = checks_at_output_instants_
-                            ? schedule.start_time + static_cast<double>(n / steps_between_checks_) / rate
-                            : simulation_.state().time;
-    guard_.check(time, simulation_.diagnostics(), simulation_.statistics());
+    instant = checks_at_output_instants_
+                  ? schedule.start_time + static_cast<double>(n / steps_between_checks_) / rate
+                  : simulation_.state().time;
   } else if (simulation_.at_end()) {
-    guard_.check(schedule.end_time, simulation_.diagnostics(), simulation_.statistics());
+    instant = schedule.end_time;
   }
-}
-
-void GuardedRun::step_once() {
-  simulation_.step_on_schedule();
-  check_if_due();
+  if (instant) check(*instant);
+  return instant;
 }
 
 std::uint64_t GuardedRun::advance(std::uint64_t count, const std::vector<StepCommands>& commands, bool record,
@@ -60,7 +73,7 @@ std::uint64_t GuardedRun::advance(std::uint64_t count, const std::vector<StepCom
         if (!std::isnan(commands[taken].steering)) simulation_.set_steering_command(commands[taken].steering);
         if (!std::isnan(commands[taken].drive)) simulation_.set_drive_command(commands[taken].drive);
       }
-      step_once();
+      step();
       if (record) states->push_back(simulation_.state());
     }
   } catch (const StepError& error) {
@@ -75,7 +88,7 @@ void GuardedRun::run_to_end() {
     if (!simulation_.at_end()) states_at({simulation_.end_time()});
     return;
   }
-  while (!simulation_.at_end()) step_once();
+  while (!simulation_.at_end()) step();
 }
 
 namespace {
@@ -125,7 +138,7 @@ std::vector<CartState> GuardedRun::dense_states_at(const std::vector<double>& ti
     if (time > simulation_.state().time) {
       simulation_.advance_output_to(time);  // the member's own steps, and its dense output at `time`
       off_grid_ = true;
-      guard_.check(time, simulation_.diagnostics(), simulation_.statistics());
+      check(time);
     }
     states.push_back(simulation_.state());
     if (observe) observe(simulation_);
@@ -171,7 +184,7 @@ std::vector<CartState> GuardedRun::grid_states_at(const std::vector<double>& tim
   std::vector<CartState> states;
   states.reserve(times.size());
   for (std::uint64_t n : targets) {
-    while (simulation_.steps_taken() < n) step_once();
+    while (simulation_.steps_taken() < n) step();
     states.push_back(simulation_.state());
     if (observe) observe(simulation_);
   }
@@ -182,8 +195,7 @@ void GuardedRun::reset() {
   simulation_.reset();
   off_grid_ = false;
   guard_.reset();
-  guard_.check(simulation_.schedule().start_time, simulation_.diagnostics(), simulation_.statistics());
+  check_start();
 }
 
-}  // namespace python
 }  // namespace birkhoff_cart
