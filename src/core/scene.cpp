@@ -4,7 +4,6 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
@@ -259,12 +258,14 @@ SceneError::SceneError(const std::string& file, const std::string& key, const st
 
 namespace {
 
-/// Parses `stream` as YAML and reads the scene, naming `source` in every SceneError.
-Scene parse_scene(std::istream& stream, const std::string& source) {
+/// Parses `text` as YAML, within the bounds of check_scene_structure, and reads the scene, naming
+/// `source` in every SceneError.
+Scene parse_scene(const std::string& text, const std::string& source) {
   const SceneReader reader(source);
   YAML::Node root;
   try {
-    root = YAML::Load(stream);
+    scene_detail::check_scene_structure(reader, text);
+    root = YAML::Load(text);
   } catch (const YAML::ParserException& error) {
     reader.fail("(syntax)", "YAML syntax error at line " + std::to_string(error.mark.line + 1) + ", column " +
                                 std::to_string(error.mark.column + 1) + ": " + error.msg);
@@ -280,15 +281,8 @@ Scene parse_scene(std::istream& stream, const std::string& source) {
 
 }  // namespace
 
-Scene load_scene(const std::string& path) {
-  std::ifstream stream(path);
-  if (!stream) SceneReader(path).fail("(file)", "cannot be opened for reading");
-  return parse_scene(stream, path);
-}
+Scene load_scene(const std::string& path) { return parse_scene(read_scene_file(path), path); }
 
-Scene load_scene_text(const std::string& text, const std::string& source) {
-  std::istringstream stream(text);
-  return parse_scene(stream, source);
-}
+Scene load_scene_text(const std::string& text, const std::string& source) { return parse_scene(text, source); }
 
 }  // namespace birkhoff_cart

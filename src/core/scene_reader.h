@@ -56,6 +56,11 @@ class SceneReader {
   std::string file_;
 };
 
+/// Refuses `text` (a scene document) longer than kMaxSceneBytes, nested deeper than kMaxSceneDepth
+/// or holding a key or value that is not UTF-8, naming the key where it happens; YAML syntax errors
+/// are the parser's (YAML::ParserException). One pass over the parser's events, no tree built.
+void check_scene_structure(const SceneReader& reader, const std::string& text);
+
 /// "a, b, c".
 std::string join_names(const std::vector<std::string>& names);
 

@@ -154,8 +154,9 @@ def test_batches_single_steps_and_one_run_end_in_the_same_state():
         singles.step()
     assert np.array_equal(whole, batches.state()) and np.array_equal(whole, singles.state())
     assert batches.steps_taken == 100
-    assert np.array_equal(batches.step(5), whole)  # at the end: no further step
-    assert batches.steps_taken == 100
+    with pytest.raises(simulator.EndOfRunError):  # at the end: no further step
+        batches.step(5)
+    assert batches.steps_taken == 100 and np.array_equal(batches.state(), whole)
 
 
 def test_torque_commands_per_step_equal_one_command_a_call_and_are_held():

@@ -123,6 +123,30 @@ TEST(CartSimulateRobustness, AnOutputRateWithAHugeStepCountIsRefused) {
   std::remove(temp_path("never.csv").c_str());
 }
 
+TEST(CartSimulateRobustness, ScenesBeyondTheSizeCapAndEndlessInputAreRefusedByName) {
+  // A 10 MB scene kept cart_simulate busy 13 s at ~950 MB before refusing it; endless input on
+  // stdin ended in std::bad_alloc. Both are now refused by the core's bounded read (exit 3).
+  const std::string big = temp_path("ten_megabytes.yaml");
+  {
+    std::ofstream file(big);
+    file << read_file(scene_path("free_coast"));
+    for (int line = 0; line < 100000; ++line) file << "# " << std::string(98, 'x') << "\n";  // 10 MB of comments
+  }
+  const Outcome too_big = run("--scene '" + big + "' --output '" + temp_path("never.csv") + "'");
+  EXPECT_EQ(too_big.exit_status, 3) << too_big.standard_error;
+  EXPECT_NE(too_big.standard_error.find("key '(file)': is 10"), std::string::npos) << too_big.standard_error;
+  EXPECT_NE(too_big.standard_error.find("beyond the cap of 1048576 bytes"), std::string::npos) << too_big.standard_error;
+  std::remove(big.c_str());
+  const Outcome endless = run("--scene /dev/stdin --output '" + temp_path("never.csv") + "' < /dev/zero");
+  EXPECT_EQ(endless.exit_status, 3) << endless.standard_error;
+  EXPECT_NE(endless.standard_error.find("holds more than the cap of 1048576 bytes"), std::string::npos)
+      << endless.standard_error;
+  const Outcome directory = run("--scene '" + ::testing::TempDir() + "' --output '" + temp_path("never.csv") + "'");
+  EXPECT_EQ(directory.exit_status, 3) << directory.standard_error;
+  EXPECT_NE(directory.standard_error.find("is a directory"), std::string::npos) << directory.standard_error;
+  std::remove(temp_path("never.csv").c_str());
+}
+
 TEST(CartSimulateRobustness, HelpAndVersionExitZeroOnStdout) {
   for (const char* option : {"--help", "-h"}) {
     const Outcome outcome = run(option);

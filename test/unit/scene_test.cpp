@@ -419,6 +419,76 @@ TEST_F(SceneFiles, EveryEffectCoefficientIsCheckedInItsRowsRange) {
   EXPECT_GE(checked, 16);
 }
 
+/// The SceneError `load` throws (ADD_FAILURE when it throws none).
+template <typename Load>
+SceneError scene_error_of(Load load) {
+  try {
+    load();
+  } catch (const SceneError& error) {
+    return error;
+  }
+  ADD_FAILURE() << "no SceneError";
+  return SceneError("", "", "");
+}
+
+TEST_F(SceneFiles, AFileBeyondTheSizeCapIsRefusedBeforeItIsRead) {
+  // A valid scene padded with a comment to one byte past kMaxSceneBytes: refused by its size alone.
+  std::string text = kMinimalScene + "# ";
+  text += std::string(kMaxSceneBytes + 1 - text.size(), 'x');
+  ASSERT_EQ(text.size(), kMaxSceneBytes + 1);
+  const std::string path = write("one_byte_too_long", text);
+  const SceneError error = scene_error_of([&] { load_scene(path); });
+  EXPECT_EQ(error.key(), "(file)");
+  EXPECT_NE(std::string(error.what()).find("is 1048577 bytes, beyond the cap of 1048576 bytes"), std::string::npos)
+      << error.what();
+  text.pop_back();  // exactly at the cap: read, and then refused only for its content (none here)
+  EXPECT_NO_THROW(load_scene(write("at_the_cap", text)));
+  EXPECT_EQ(read_scene_file(write("at_the_cap", text)).size(), kMaxSceneBytes);
+}
+
+TEST_F(SceneFiles, AnEndlessDeviceIsReadNoFurtherThanTheCap) {
+  // /dev/zero (as a pipe on stdin would) never ends: read up to the cap, then refused.
+  const SceneError error = scene_error_of([] { load_scene("/dev/zero"); });
+  EXPECT_EQ(error.key(), "(file)");
+  EXPECT_NE(std::string(error.what()).find("holds more than the cap of 1048576 bytes"), std::string::npos)
+      << error.what();
+}
+
+TEST_F(SceneFiles, ADirectoryIsRefusedAsADirectory) {
+  const SceneError error = scene_error_of([&] { load_scene(directory_); });
+  EXPECT_EQ(error.key(), "(file)");
+  EXPECT_NE(std::string(error.what()).find("is a directory, not a scene file"), std::string::npos) << error.what();
+}
+
+TEST_F(SceneFiles, NestingBeyondTheDepthCapIsRefusedByItsKey) {
+  // 100 000 maps deep in flow style (~600 kB): refused at level 65 by the key path, before a tree is
+  // built (yaml-cpp would stop at its own 2000 levels with a syntax error, after building them).
+  std::string deep = kMinimalScene + "deep: ";
+  for (int level = 0; level < 100000; ++level) deep += "{a: ";
+  deep += "1" + std::string(100000, '}') + "\n";
+  const SceneError error = scene_error_of([&] { load_scene(write("deep", deep)); });
+  std::string key = "deep";
+  for (int level = 2; level <= kMaxSceneDepth; ++level) key += ".a";  // levels 2..64 hold key a
+  EXPECT_EQ(error.key(), key);
+  EXPECT_NE(std::string(error.what()).find("deeper than the cap of 64 levels"), std::string::npos) << error.what();
+  // At the cap the structure passes, and the reader names the unknown key.
+  std::string at_cap = kMinimalScene + "deep: ";
+  for (int level = 2; level <= kMaxSceneDepth; ++level) at_cap += "[";
+  at_cap += std::string(kMaxSceneDepth - 1, ']') + "\n";
+  EXPECT_EQ(scene_error_of([&] { load_scene(write("at_cap", at_cap)); }).key(), "deep");
+  EXPECT_EQ(scene_error_of([&] { load_scene_text(deep, "<text>"); }).key(), key);  // the same for text
+}
+
+TEST_F(SceneFiles, TextThatIsNotUtf8IsRefusedByItsKey) {
+  const SceneError in_key = scene_error_of([&] { load_scene(write("key", kMinimalScene + "car\xfft: 1\n")); });
+  EXPECT_EQ(in_key.key(), "car\\xfft");
+  EXPECT_NE(std::string(in_key.what()).find("is not UTF-8 text"), std::string::npos) << in_key.what();
+  const SceneError in_value =
+      scene_error_of([&] { load_scene(write("value", edited("minimal test scene", "minimal \xc3\x28 scene"))); });
+  EXPECT_EQ(in_value.key(), "description");
+  EXPECT_NE(std::string(in_value.what()).find("byte 0xc3 at offset 8"), std::string::npos) << in_value.what();
+}
+
 TEST_F(SceneFiles, NonexistentFileNamesTheFile) {
   const std::string path = directory_ + "/no_such_scene.yaml";
   try {

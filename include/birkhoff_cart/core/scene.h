@@ -3,8 +3,9 @@
 // struct itself is plain data.
 #pragma once
 
-#include <stdexcept>
+#include <cstddef>
 #include <limits>
+#include <stdexcept>
 #include <optional>
 #include <string>
 #include <vector>
@@ -59,12 +60,25 @@ struct Scene {
   ActuatorSettings actuators;
 };
 
-/// Loads and validates a scene. Throws SceneError naming the file and the key.
+/// The largest scene a face reads [bytes] (the study runner's cap, MAX_SCENE_BYTES): a longer file is
+/// refused before it is parsed, a pipe or device read no further (docs/scenes.md "Limits").
+constexpr std::size_t kMaxSceneBytes = 1024 * 1024;
+/// The deepest nesting of maps and lists in a scene (its root map is level 1; the shipped scenes
+/// use at most 4).
+constexpr int kMaxSceneDepth = 64;
+
+/// The text of the scene file at `path`, read within kMaxSceneBytes. SceneError (key "(file)") for a
+/// file that cannot be opened, a directory, or a longer file, pipe or device.
+std::string read_scene_file(const std::string& path);
+
+/// Loads and validates a scene (its text by read_scene_file). Throws SceneError naming the file and
+/// the key.
 Scene load_scene(const std::string& path);
 
 /// The same from the YAML text of a scene document; `source` stands for the file in the scene's
 /// name (its stem), source_path and every SceneError (the Python module: a dict, or a file with
-/// overrides).
+/// overrides). Within the same bounds: at most kMaxSceneBytes, nested at most kMaxSceneDepth deep,
+/// UTF-8 (each refused by the key where it happens, before the document is built).
 Scene load_scene_text(const std::string& text, const std::string& source);
 
 }  // namespace birkhoff_cart
