@@ -30,14 +30,16 @@ def dump_instructions(path):
 
 def top_functions(path, count):
     """The `count` functions with the largest self cost in one dump, as (share, name)."""
-    out = subprocess.run(["callgrind_annotate", "--inclusive=no", str(path)], capture_output=True, text=True,
-                         check=True).stdout
+    out = subprocess.run(["callgrind_annotate", "--inclusive=no", "--threshold=100", str(path)], capture_output=True,
+                         text=True, check=True).stdout
     total = dump_instructions(path)
     rows = []
     for line in out.splitlines():
         match = re.match(r"^\s*([\d,]+)\s+\([^)]*\)\s+(.*)$", line)
         if match and "PROGRAM TOTALS" not in line:
-            rows.append((int(match.group(1).replace(",", "")) / total, match.group(2).strip()))
+            share = int(match.group(1).replace(",", "")) / total
+            if share < 0.999:  # the callers of the region (main, run_price, ...) show the whole run
+                rows.append((share, match.group(2).strip()))
         if len(rows) >= count:
             break
     return rows
@@ -65,18 +67,23 @@ def main():
         return 1
     dumps = sorted((p for p in out_dir.glob("callgrind.out.*") if p.suffix[1:].isdigit()),
                    key=lambda p: int(p.suffix[1:]))
+    skipped = 0  # dumps of runs that failed part way
     scenes = []  # [header line, [(method, control, setting, evaluations, Ir/evaluation, dump) or refused line]]
     for line in run.stdout.splitlines():
         match = ROW.match(line.replace("bare rhs", "bare_rhs", 1))
         if match:
             method, control, setting, _steps, _rejected, evaluations = match.groups()
-            if len(dumps) <= sum(isinstance(r, tuple) for _, rows in scenes for r in rows):
+            index = sum(isinstance(r, tuple) for _, rows in scenes for r in rows) + skipped
+            if len(dumps) <= index:
                 sys.stderr.write("price_callgrind: fewer profile dumps than cells\n")
                 return 1
-            dump = dumps[sum(isinstance(r, tuple) for _, rows in scenes for r in rows)]
+            dump = dumps[index]
             scenes[-1][1].append((method, control, setting, int(evaluations),
                                   dump_instructions(dump) / max(1, int(evaluations)), dump))
-        elif "refused or failed" in line:
+        elif "  refused: " in line:
+            scenes[-1][1].append(line)
+        elif "  failed part way: " in line:  # its run started in price_region(): a dump of its own
+            skipped += 1
             scenes[-1][1].append(line)
         elif line and not line.startswith("Price") and not line.startswith("  method"):
             scenes.append((line, []))

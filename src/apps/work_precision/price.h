@@ -65,6 +65,7 @@ __attribute__((noinline)) inline void price_region(const std::function<void()>& 
 /// What one cell measured.
 struct PriceCell {
   std::string status = "ok";
+  bool started = false;             ///< the run began (a failure then ended it part way)
   double cpu_median = NAN;          ///< [s]
   std::uint64_t evaluations = 0;    ///< right-hand-side evaluations of one run
   std::uint64_t steps = 0;          ///< accepted steps of one run
@@ -75,6 +76,7 @@ struct PriceCell {
 /// Runs `run` (which sets `evaluations`) as the settings say: once in price_region() with
 /// --callgrind, else a warm-up and `repetitions` timed runs (CPU time, median).
 inline void time_cell(const PriceSettings& settings, PriceCell& cell, const std::function<void()>& run) {
+  cell.started = true;
   if (settings.callgrind) {
     price_region(run);
     cell.cpu_median = NAN;
@@ -201,7 +203,8 @@ PriceCell price_bare_rates(const PriceSettings& settings, const Scene& base, std
 inline void print_price_row(const char* method, const char* control, const std::string& setting, const PriceCell& cell,
                             double fixed, double bare, double bare_birkhoffian) {
   if (cell.status != "ok") {
-    std::printf("  %-16s %-10s %-12s  refused or failed: %s\n", method, control, setting.c_str(), cell.status.c_str());
+    std::printf("  %-16s %-10s %-12s  %s: %s\n", method, control, setting.c_str(),
+                cell.started ? "failed part way" : "refused", cell.status.c_str());
     return;
   }
   const double price = cell.nanoseconds_per_evaluation();
