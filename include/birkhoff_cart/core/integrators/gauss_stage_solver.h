@@ -286,19 +286,12 @@ class GaussStageSolver {
     for (int slot = 0; slot < memory.cached; ++slot) {
       if (memory.cached_step[slot] == h) return memory.cached_inverse[slot];
     }
-    // A new h with the same J (a step control changes h every step): J's factors are taken over
-    // from a cached inverse and only the s × s part is computed (kronecker_newton.h).
     const int slot = memory.next_slot;
-    const int same_jacobian = memory.cached > 0 ? (slot == 0 ? memory.cached - 1 : slot - 1) : -1;
     memory.next_slot = (slot + 1) % CollocationMemory<System, Stages>::kCachedStepSizes;
     memory.cached = std::max(memory.cached, slot + 1);
     memory.cached_step[slot] = h;
-    const bool built = same_jacobian >= 0 && same_jacobian != slot
-                           ? memory.cached_inverse[slot].rebuild_for_step(memory.cached_inverse[same_jacobian],
-                                                                          tableau.coefficients, h)
-                           : memory.cached_inverse[slot].build(memory.jacobian, tableau.coefficients, h,
-                                                               system_traits::kCyclicMask<System>);
-    if (!built) {
+    if (!memory.cached_inverse[slot].build(memory.jacobian, tableau.coefficients, h,
+                                           system_traits::kCyclicMask<System>)) {
       memory.cached = 0;
       fail_collocation_step("met a singular Newton matrix", t_jacobian - 0.5 * h, 0);
     }

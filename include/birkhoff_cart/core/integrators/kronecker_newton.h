@@ -56,26 +56,7 @@ class KroneckerNewtonInverse {
       }
     }
     return with_block_size(m_, [&](auto block) {
-      build_jacobian_block<decltype(block)::value>(jacobian);
-      return build_step_block<decltype(block)::value>(coefficients, h);
-    });
-  }
-
-  /// M⁻¹ for the J of `same_jacobian` (built by build()) and X = h·coefficients: J's part (the
-  /// block, J^p, the characteristic polynomial, the cyclic rows J_ca J^p) is taken over and only the
-  /// s × s part f_p(X), X f_p(X) is computed, so that a new step size with the same J costs about
-  /// half a build. The same numbers as build(J, coefficients, h) bit for bit. false as build().
-  template <class Coefficients>
-  bool rebuild_for_step(const KroneckerNewtonInverse& same_jacobian, const Coefficients& coefficients, double h) {
-    m_ = same_jacobian.m_;
-    cyclic_count_ = same_jacobian.cyclic_count_;
-    active_ = same_jacobian.active_;
-    cyclic_ = same_jacobian.cyclic_;
-    characteristic_ = same_jacobian.characteristic_;
-    j_power_ = same_jacobian.j_power_;
-    row_power_ = same_jacobian.row_power_;
-    return with_block_size(m_, [&](auto block) {
-      return build_step_block<decltype(block)::value>(coefficients, h);
+      return build_block<decltype(block)::value>(jacobian, coefficients, h);
     });
   }
 
@@ -107,10 +88,9 @@ class KroneckerNewtonInverse {
     }
   }
 
-  /// J's part of build() on a block of m coordinates (m a constant: the loops unroll): J^p, the
-  /// characteristic polynomial's e_k, the cyclic rows J_ca J^p.
-  template <int m>
-  void build_jacobian_block(const Jacobian& jacobian) {
+  /// build() on a block of m coordinates (m a constant: the loops unroll).
+  template <int m, class Coefficients>
+  bool build_block(const Jacobian& jacobian, const Coefficients& coefficients, double h) {
     Small j_aa{};
     for (int a = 0; a < m; ++a) {
       for (int b = 0; b < m; ++b) j_aa[a][b] = jacobian(active_[a], active_[b]);
@@ -120,8 +100,7 @@ class KroneckerNewtonInverse {
     for (int p = 1; p < m; ++p) multiply(j_aa, j_power_[p - 1], j_power_[p], m);
     // e_k: det(xI − J) = Σ_k (−1)^k e_k x^{m−k} = Σ_k c_{m−k} x^{m−k}, e_k = (−1)^k c_{m−k}.
     // Faddeev–LeVerrier: B₁ = I, c_{m−k} = −tr(J B_k)/k, B_{k+1} = J B_k + c_{m−k} I.
-    std::array<double, n + 1>& e = characteristic_;
-    e = {};
+    std::array<double, n + 1> e{};
     e[0] = 1.0;
     Small b_k = j_power_[0];
     for (int k = 1; k <= m; ++k) {
@@ -134,30 +113,11 @@ class KroneckerNewtonInverse {
       for (int a = 0; a < m; ++a) jb[a][a] += c;
       b_k = jb;
     }
-    // The cyclic rows: J_ca J^p.
-    for (int c = 0; c < cyclic_count_; ++c) {
-      for (int p = 0; p < m; ++p) {
-        for (int b = 0; b < m; ++b) {
-          double sum = 0.0;
-          for (int a = 0; a < m; ++a) sum += jacobian(cyclic_[c], active_[a]) * j_power_[p][a][b];
-          row_power_[c][p][b] = sum;
-        }
-      }
-    }
-  }
-
-  /// The step's part of build() on a block of m coordinates, for the J part already in place:
-  /// f_p(X) and X f_p(X) for X = h·coefficients. false when D(X) is singular or a factor not finite.
-  template <int m, class Coefficients>
-  bool build_step_block(const Coefficients& coefficients, double h) {
-    const std::array<double, n + 1>& e = characteristic_;
     // y_j = X^j D(X)⁻¹, j ≤ m: f_p = Σ_{p≤j<m} (−1)^{j−p} e_{j−p} y_j and X f_p the same on y_{j+1}.
-    std::array<Square, n + 1> x_power;  // X^k, k ≤ m (each entry written before it is read)
+    std::array<Square, n + 1> x_power{};
     for (int i = 0; i < s; ++i) {
-      for (int j = 0; j < s; ++j) {
-        x_power[0][i][j] = i == j ? 1.0 : 0.0;
-        x_power[1][i][j] = h * coefficients[i][j];
-      }
+      x_power[0][i][i] = 1.0;
+      for (int j = 0; j < s; ++j) x_power[1][i][j] = h * coefficients[i][j];
     }
     for (int k = 2; k <= m; ++k) multiply(x_power[1], x_power[k - 1], x_power[k], s);
     Eigen::Matrix<double, s, s> denominator = Eigen::Matrix<double, s, s>::Zero();  // D(X)
@@ -170,7 +130,7 @@ class KroneckerNewtonInverse {
     // Eigen's closed-form inverse for s ≤ 4; a singular D gives non-finite entries (checked below).
     const Eigen::Matrix<double, s, s> denominator_inverse = denominator.inverse();
     if (!denominator_inverse.allFinite()) return false;
-    std::array<Square, n + 1> y;  // y_k, k ≤ m (each entry written before it is read)
+    std::array<Square, n + 1> y{};
     for (int k = 0; k <= m; ++k) {
       for (int i = 0; i < s; ++i) {
         for (int j = 0; j < s; ++j) {
@@ -190,6 +150,16 @@ class KroneckerNewtonInverse {
             f_[p][r][q] += coefficient * y[j][r][q];
             x_f_[p][r][q] += coefficient * y[j + 1][r][q];
           }
+        }
+      }
+    }
+    // The cyclic rows: J_ca J^p.
+    for (int c = 0; c < cyclic_count_; ++c) {
+      for (int p = 0; p < m; ++p) {
+        for (int b = 0; b < m; ++b) {
+          double sum = 0.0;
+          for (int a = 0; a < m; ++a) sum += jacobian(cyclic_[c], active_[a]) * j_power_[p][a][b];
+          row_power_[c][p][b] = sum;
         }
       }
     }
@@ -252,19 +222,20 @@ class KroneckerNewtonInverse {
     }
   }
 
-  /// Every factor finite: x·0 is 0 for a finite x and NaN for ±∞ and NaN, so one sum tells (and
-  /// never overflows), without a branch per entry.
   bool all_finite() const {
-    double zero = 0.0;
     for (int p = 0; p < m_; ++p) {
       for (int i = 0; i < s; ++i) {
-        for (int j = 0; j < s; ++j) zero += f_[p][i][j] * 0.0 + x_f_[p][i][j] * 0.0;
+        for (int j = 0; j < s; ++j) {
+          if (!std::isfinite(f_[p][i][j]) || !std::isfinite(x_f_[p][i][j])) return false;
+        }
       }
       for (int a = 0; a < m_; ++a) {
-        for (int b = 0; b < m_; ++b) zero += j_power_[p][a][b] * 0.0;
+        for (int b = 0; b < m_; ++b) {
+          if (!std::isfinite(j_power_[p][a][b])) return false;
+        }
       }
     }
-    return zero == 0.0;
+    return true;
   }
 
   int m_ = 0;                                 ///< coordinates in the block
@@ -274,7 +245,6 @@ class KroneckerNewtonInverse {
   std::array<Square, n> f_{};                 ///< f_p(X), p < m
   std::array<Square, n> x_f_{};               ///< X f_p(X)
   std::array<Small, n> j_power_{};            ///< J^p on the block, p < m
-  std::array<double, n + 1> characteristic_{};  ///< e_k of det(xI − J) on the block, k ≤ m
   std::array<std::array<std::array<double, n>, n>, n> row_power_{};  ///< [cyclic][p]: J_ca J^p
 };
 
