@@ -3,6 +3,7 @@
 //
 //   work_precision --measure ...        one method at one setting on one scene: one JSON row
 //   work_precision --reference-run ...  a reference (or its check setting) at the checkpoints
+//   work_precision --price ...          the price of an evaluation per method and control, per scene
 //
 // The methods: every registry member (integrator_names()) through Simulation, as the CLI and the
 // node run them, and Boost.Odeint's runge_kutta4, controlled runge_kutta_dopri5,
@@ -19,6 +20,7 @@
 #include <string>
 
 #include "birkhoff_cart/core/version.h"
+#include "work_precision/price.h"
 #include "work_precision/single_task.h"
 
 using namespace birkhoff_cart::work_precision;
@@ -29,9 +31,11 @@ const char* const kUsage =
     "                      (--reference-file REF.csv | --analytic-reference)\n"
     "       work_precision --reference-run --scene FILE --duration T --reference-kind extended_precision|dopri5\n"
     "                      [--checkpoints t1,t2,...] [--check-setting] --output REF.csv\n"
+    "       work_precision --price [--scene NAME] [--scenes-dir DIR] [--tolerance TOL] [--peer-tolerance TOL]\n"
+    "                      [--repetitions N] [--callgrind]\n"
     "       work_precision --help | -h | --version\n"
     "One task of a study (scripts/study, docs/studies.md): one JSON row on stdout. The whole benchmark:\n"
-    "bash scripts/run_benchmark.sh.\n"
+    "bash scripts/run_benchmark.sh. --price: the price table of docs/benchmarks.md (ns per evaluation).\n"
     "Exit status: 0 done; 1 failed (a file cannot be written, a scene cannot be loaded); 2 bad arguments;\n"
     "4 the measured run failed (its row says why).\n";
 
@@ -43,6 +47,21 @@ int main(int argc, char** argv) {
     }
   }
   if (birkhoff_cart::print_version_if_asked(argc, argv, "work_precision")) return 0;
+  if (argc > 1 && std::string(argv[1]) == "--price") {
+    PriceSettings settings;
+    try {
+      settings = parse_price_settings(argc, argv);
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "work_precision: %s\n%s", error.what(), kUsage);
+      return 2;
+    }
+    try {
+      return run_price(settings);
+    } catch (const std::exception& error) {
+      std::fprintf(stderr, "work_precision: %s\n", error.what());
+      return 1;
+    }
+  }
   SingleTask task;
   try {
     task = parse_single_task(argc, argv);

@@ -27,6 +27,7 @@
 #include "odeint_peers.h"
 #include "ours.h"
 #include "output.h"
+#include "price.h"
 #include "reference.h"
 
 namespace birkhoff_cart {
@@ -122,6 +123,31 @@ inline SingleTask parse_single_task(int argc, char** argv) {
   }
   if (task.label.empty()) task.label = task.scene_file;
   return task;
+}
+
+/// The settings of `work_precision --price ...` (price.h).
+inline PriceSettings parse_price_settings(int argc, char** argv) {
+  PriceSettings settings;
+  for (int i = 2; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) throw std::invalid_argument("option " + arg + " needs a value");
+      return argv[++i];
+    };
+    if (arg == "--scene") settings.only_scene = value();
+    else if (arg == "--scenes-dir") settings.scenes_dir = value();
+    else if (arg == "--tolerance") settings.position_tolerance = positive_number(arg, value());
+    else if (arg == "--peer-tolerance") settings.peer_tolerance = positive_number(arg, value());
+    else if (arg == "--callgrind") settings.callgrind = true;
+    else if (arg == "--repetitions") {
+      const double r = positive_number(arg, value());
+      if (r != std::floor(r) || r > 1000) throw std::invalid_argument("--repetitions needs a whole number in 1..1000");
+      settings.repetitions = static_cast<int>(r);
+    } else {
+      throw std::invalid_argument("unknown argument '" + arg + "' for --price");
+    }
+  }
+  return settings;
 }
 
 inline BenchScene single_task_scene(const SingleTask& task) {
