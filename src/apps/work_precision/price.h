@@ -263,15 +263,20 @@ void price_scene(const PriceSettings& settings, const PriceScene& entry, const S
 
 /// --price: the table of every scene (or --scene NAME's alone). 0 done; 2 no such scene.
 inline int run_price(const PriceSettings& settings) {
+  bool known = settings.only_scene.empty();
+  for (const PriceScene& entry : kPriceScenes) known = known || settings.only_scene == entry.name;
+  if (!known) {
+    std::fprintf(stderr, "work_precision --price: no scene named '%s' (jackknife_whirl, sine_steer_torque, "
+                         "drive_rr_drag, very_stiff_hinge)\n", settings.only_scene.c_str());
+    return 2;
+  }
   std::printf("Price of a right-hand-side evaluation: CPU / evaluations, %s\n",
               settings.callgrind ? "each cell once (callgrind: instructions per cell from the profile dumps)"
                                  : ("median of " + std::to_string(settings.repetitions) +
                                     " runs after a warm-up; /fixed = controlled over the fixed step's price")
                                        .c_str());
-  bool found = false;
   for (const PriceScene& entry : kPriceScenes) {
     if (!settings.only_scene.empty() && settings.only_scene != entry.name) continue;
-    found = true;
     Scene scene = load_scene(settings.scenes_dir + "/" + entry.name + ".yaml");
     scene.reference = ReferenceSettings{};
     scene.duration = entry.duration;
@@ -280,11 +285,6 @@ inline int run_price(const PriceSettings& settings) {
     } else {
       price_scene<CartAutonomousBirkhoffian>(settings, entry, scene);
     }
-  }
-  if (!found) {
-    std::fprintf(stderr, "work_precision --price: no scene named '%s' (jackknife_whirl, sine_steer_torque, "
-                         "drive_rr_drag, very_stiff_hinge)\n", settings.only_scene.c_str());
-    return 2;
   }
   return 0;
 }
