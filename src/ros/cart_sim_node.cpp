@@ -58,7 +58,15 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   if (!parameters_.integrator.empty()) scene.integrator.name = parameters_.integrator;
   if (parameters_.step_size > 0.0) scene.integrator.step_size = parameters_.step_size;
   if (!parameters_.step_control.empty()) scene.integrator.step_control = parse_step_control(parameters_.step_control);
-  if (parameters_.position_tolerance > 0.0) scene.integrator.position_tolerance = parameters_.position_tolerance;
+  if (parameters_.position_tolerance > 0.0) {
+    if (scene.integrator.step_control == StepControl::kFixed) {
+      throw NodeStartupError("bad parameter: ~position_tolerance " + format_seconds(parameters_.position_tolerance) +
+                             " m is the position error for a step control, and the run steps at fixed steps (scene " +
+                             parameters_.scene_path +
+                             "): give ~step_control adaptive or reversible with it, or leave it out");
+    }
+    scene.integrator.position_tolerance = parameters_.position_tolerance;
+  }
   try {
     simulation_ = std::make_unique<Simulation>(scene);
   } catch (const std::exception& error) {
