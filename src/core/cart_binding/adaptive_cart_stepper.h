@@ -4,8 +4,10 @@
 // from the grid's Hermite dense output (hermite_dense_output.h). Private to the core library
 // (integrator_registry.cpp makes it).
 //
-// Tolerance → τ (eq. (B.48)): the allowed error per unit step is τ = position_tolerance / horizon,
-// so that the estimated local errors of a run add up to at most the tolerance by its horizon.
+// Tolerance → the estimate's aim (eqs. (B.48), (B.53)): τ = position_tolerance / horizon is the error
+// per second the run may gather; the control accepts ê ≤ τ_a·h with τ_a = c·τ^α, the member's
+// tolerance proportionality (tolerance_proportionality.h), so that the delivered error lands at the
+// tolerance rather than orders below it. The stage solve still stops at κ·τ·h (B.49).
 //
 // Where the grid must land exactly rather than interpolate: the instants given to land_on() (the
 // run's end: Simulation passes it), the loads' kinks (Effect::next_kink_after: a step across a
@@ -24,6 +26,7 @@
 #include "birkhoff_cart/core/integrators/adaptive_step_control.h"
 #include "controlled_cart_stepper.h"
 #include "step_checks.h"
+#include "tolerance_proportionality.h"
 
 namespace birkhoff_cart {
 
@@ -51,7 +54,10 @@ class AdaptiveCartStepperAdapter final
  private:
   static AdaptiveStepSettings control_settings(const IntegratorSettings& settings) {
     AdaptiveStepSettings control;
-    control.error_per_unit_step = stepper_checks::error_per_unit_step(settings, "adaptive");
+    const double asked = stepper_checks::error_per_unit_step(settings, "adaptive");  // τ [1/s] (B.48)
+    control.error_per_unit_step = aimed_error_per_unit_step<AdaptiveToleranceProportionality<Stepper>>(asked);
+    // The stage solve stops at κ·τ·h of the asked τ (B.49), not of the aim.
+    control.stage_change_fraction *= asked / control.error_per_unit_step;
     return control;
   }
 

@@ -2,13 +2,16 @@
 // (docs/birkhoffian.md §12, eqs. (B.46)–(B.49)). The member's own local error estimate ê (the
 // collocation defect, eq. (B.37); a composition's sum of its sub-steps') decides each step:
 //
-//   accept when ê ≤ τ·|h|      (error per unit step: the errors of a run add up to ≈ τ·T)      (B.46)
+//   accept when ê ≤ τ·|h|      (error per unit step)                                           (B.46)
 //   h_new = h · min(α_max, max(α_min, 0.9·(τ|h|/ê)^{1/(q−1)}))   (ê ∝ h^q)                     (B.47)
 //
-// with τ [1/s] the allowed error per second in ê's units (absolute below 1 SI unit, relative above;
-// error_estimate.h). A step that is rejected — by the estimate, or because its stage solve did not
-// converge, met a non-finite value or a singular matrix, or converged to a root whose estimate is
-// not finite — is retried from the same point with a smaller step (a failed solve: h/4); it never
+// with τ [1/s] the error per second the estimate is aimed at, in ê's units (absolute below 1 SI
+// unit, relative above; error_estimate.h): the adapter derives it from the position tolerance by
+// the member's tolerance proportionality (eq. (B.53)). The growth reads the larger of the last two
+// ratios ê/(τh); the accepted retry after a rejection does not grow, and while ê reads zero after a
+// rejection the steps grow by at most ceiling_growth a step (birkhoffian.md §12.1). A step that is
+// rejected — by the estimate, or because its stage solve did not converge, met a non-finite value
+// or a singular matrix, or converged to a root whose estimate is not finite — is retried from the same point with a smaller step (a failed solve: h/4); it never
 // reaches the caller. The stage solve stops at κ·τ·|h| (CollocationMemory::stage_change_limit,
 // eq. (B.49)), not at round-off. A step never passes the limit it is given: the run's end, a
 // landing instant, a kink of the loads (the caller passes them); it is stretched by up to 10 % to
@@ -49,6 +52,7 @@ struct AdaptiveStepSettings {
   double start_growth = 100.0;         ///< α_max while the steps after a start still grow unhindered [-]
   double keep_ratio = 1.2;             ///< a step that would grow by less is kept (its Newton matrix reused) [-]
   double max_shrink = 0.2;             ///< α_min: smallest factor after a rejection [-]
+  double ceiling_growth = 1.02;        ///< growth a step after a rejection while ê reads 0 [-]
   std::uint64_t max_steps_per_advance = 1000000;  ///< work limit between two limits [-]
 };
 
@@ -105,6 +109,8 @@ class AdaptiveStepControl {
     last_error_ratio_ = 0.0;
     last_step_ = 0.0;
     ramping_ = true;
+    ceiling_ = std::numeric_limits<double>::infinity();
+    after_rejection_ = false;
   }
 
   /// After a kink of the loads at the grid's time: the stage derivatives before it do not extrapolate.
@@ -158,6 +164,8 @@ class AdaptiveStepControl {
         ramping_ = false;
         const double factor = solved && std::isfinite(ratio) ? shrink_factor(ratio) : 0.25;
         proposed_step_ = h * factor;
+        ceiling_ = proposed_step_;
+        after_rejection_ = true;
         continue;
       }
       previous_ = saved_point;
@@ -175,7 +183,10 @@ class AdaptiveStepControl {
       statistics.internal_step_min = std::min(statistics.internal_step_min, h);
       statistics.internal_step_max = std::max(statistics.internal_step_max, h);
       // A landing step was cut to fit: the step after it is the one the controller wanted.
-      double factor = growth_factor(ratio);
+      // Growth from the larger of this step's and the last step's ratio: where ê swings with the phase
+      // of a fast oscillation (the stiff hinge's 400 rad/s), one low reading does not invite a step
+      // the next phase rejects.
+      double factor = growth_factor(std::max(ratio, lands ? 0.0 : last_error_ratio_));
       // Gustafsson's predictive term (as RADAU5): where ê/h grows from step to step, shrink ahead
       // of the rejection that would follow: h/h₋ · (r₋/r)^{1/k} · r^{-1/k}.
       if (last_error_ratio_ > 0.0 && ratio > 0.0 && last_step_ > 0.0 && !lands) {
@@ -183,6 +194,19 @@ class AdaptiveStepControl {
                                   std::pow(last_error_ratio_ / (ratio * ratio), 1.0 / kExponentOrder);
         factor = std::min(factor, std::max(settings_.max_shrink, predictive));
       }
+      // After a rejection (Hairer–Nørsett–Wanner I §II.4): the accepted retry does not grow; and while
+      // the steps' estimates stay below their round-off floor (ratio 0: no error seen, no prediction)
+      // they grow from the retry's size by at most ceiling_growth a step instead of max_growth (on the
+      // very stiff hinge at 1e-9 m a 4× growth from "no error seen" is rejected at ê ≈ 500 τh and
+      // retried 4× smaller: every other step). An estimate above its floor predicts again.
+      if (after_rejection_) factor = std::min(factor, 1.0);
+      if (ratio > 0.0) {
+        ceiling_ = std::numeric_limits<double>::infinity();
+      } else if (!lands) {
+        ceiling_ *= settings_.ceiling_growth;
+        factor = std::min(factor, std::max(1.0, ceiling_ / h));
+      }
+      after_rejection_ = false;
       // A step that would grow by less than keep_ratio stays as it is: its Newton matrix is cached
       // by h (RADAU5's rule, Hairer–Wanner II §IV.8); on the stiff hinge this saved 10–15 %.
       if (!lands && factor >= 1.0 && factor <= settings_.keep_ratio) factor = 1.0;
@@ -255,6 +279,8 @@ class AdaptiveStepControl {
   double last_error_ratio_ = 0.0;  ///< ê/(τh) of the last accepted step [-]
   bool ramping_ = false;           ///< the steps after a start are still growing unhindered
   double last_step_ = 0.0;         ///< h of the last accepted step [s]
+  double ceiling_ = std::numeric_limits<double>::infinity();  ///< growth bound while ê reads 0 [s]
+  bool after_rejection_ = false;   ///< the attempt now running follows a rejected one
 };
 
 }  // namespace birkhoff_cart
