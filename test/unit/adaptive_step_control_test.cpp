@@ -80,7 +80,7 @@ bool time_dependent(const Scene& scene) {
 /// Loose bounds on the Gauss members under the adaptive control (docs/accuracy.md §4.3 has the
 /// measured figures): the delivered error not below tolerance / this [-], and rejected attempts at
 /// most this share of the accepted steps [-].
-constexpr double kOverdeliveryBound = 3000.0;
+constexpr double kOverdeliveryBound = 1e4;
 constexpr double kRejectedShareBound = 0.25;
 
 TEST(ToleranceProportionality, EveryShippedSceneEveryControl) {
