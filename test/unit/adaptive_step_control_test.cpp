@@ -119,8 +119,9 @@ TEST(ToleranceProportionality, EveryShippedSceneEveryControl) {
         EXPECT_LE(error, 10.0 * tolerance + 1e-10) << name << " " << setting.member << " at " << tolerance << " m";
         if (setting.control == StepControl::kAdaptive && setting.member != "dopri5") {
           // The Gauss members aim at the tolerance (eq. (B.53)), not orders below it — except where
-          // the motion is exact at any step (driven: a straight coast).
-          if (name != "driven") {
+          // the motion is exact at any step (driven: a straight coast), and judged only where the
+          // reference resolves tolerance / kOverdeliveryBound (1e-10 m).
+          if (name != "driven" && tolerance / kOverdeliveryBound >= 1e-10) {
             EXPECT_GE(error, tolerance / kOverdeliveryBound) << name << " " << setting.member << " at " << tolerance << " m";
           }
           // The controller does not thrash (a loose bound: a few rejections at the start and the kinks).
@@ -237,8 +238,10 @@ TEST(AdaptiveStepControl, AStiffHingeRunsWhereFixedStepsFail) {
                 static_cast<unsigned long long>(simulation.statistics().internal_steps),
                 static_cast<unsigned long long>(simulation.statistics().rejected_steps));
     EXPECT_LE(error, 1e-5) << member;
-    EXPECT_LE(worst_row, 1e-5) << member << ": an output row off by more than 10x the tolerance";
-    EXPECT_LE(worst_grid, 1e-6) << member << ": a grid state off by more than the tolerance";
+    // The control aims at the tolerance (eq. (B.53)): a grid state may reach twice it; the rows between
+    // steps carry the dense output's error on top (docs/accuracy.md §4).
+    EXPECT_LE(worst_row, 2e-5) << member << ": an output row off by more than 20x the tolerance";
+    EXPECT_LE(worst_grid, 2e-6) << member << ": a grid state off by more than twice the tolerance";
     EXPECT_GT(simulation.statistics().rejected_steps, 0u) << member << ": the start is stiff enough to reject";
     EXPECT_LT(largest, 2.0 * (std::abs(reference.x) + std::abs(reference.y)) + 1.0) << member;
   }
