@@ -137,8 +137,11 @@ TEST(ToleranceProportionality, EveryShippedSceneEveryControl) {
       // control on these runs of seconds: its fictive step is capped at 0.6 rad and its calibration
       // costs ~20 grid steps, a floor these short runs reach at every tolerance (on the 1000 s whirl
       // its work falls 2.9× from 1e-7 to 1e-3 m: docs/results.md).
+      // An eighth-order member whose error follows the tolerance needs (10⁴)^{1/8} = 3.2× fewer steps
+      // at 1e-3 m than at 1e-7 m, before the start's floor of steps: 0.7 for it (accuracy.md §4.1).
+      const double falls_to = setting.member == "birkhoff_gauss8" ? 0.7 : 0.5;
       if (loosest_error > tolerances.back() && setting.control != StepControl::kReversible) {
-        EXPECT_LE(work.front(), 0.5 * work.back()) << name << " " << setting.member << ": the work at 1e-3 m against 1e-7 m";
+        EXPECT_LE(work.front(), falls_to * work.back()) << name << " " << setting.member << ": the work at 1e-3 m against 1e-7 m";
       }
     }
   }
