@@ -184,7 +184,7 @@ std::string usage() {
          "                          (2.2e-15); refused for the fixed-step members\n"
          "  --step-control C        " + fixed + " (steps of H), " + reversible +
          " (symmetric Birkhoffian members, free runs) or\n"
-         "                          " + adaptive + " (Birkhoffian members and dopri5, any scene): their own\n"
+         "                          " + adaptive + " (Gauss members and dopri5, any scene): their own\n"
          "                          steps for --position-tolerance, rows at any --output-rate (docs/accuracy.md §4)\n"
          "  --position-tolerance M  " + reversible + " or " + adaptive +
          " step control: the position error [m] allowed at the horizon\n"
@@ -501,7 +501,8 @@ int run(int argc, char** argv) {
   if (sensor) std::printf("%s\n", birkhoff_cart::odometry_drift_line(*sensor, simulation.state(), simulation.model()).c_str());
   if (guard.level() == birkhoff_cart::AccuracyLevel::kError) {
     const bool warn_only = arguments.count("--on-accuracy-error") && arguments.at("--on-accuracy-error") == "warn";
-    std::fprintf(stderr, "cart_simulate: accuracy %s%s\n", guard.summary().c_str(),
+    std::fprintf(stderr, "cart_simulate: accuracy %s%s%s\n", guard.summary().c_str(),
+                 birkhoff_cart::accuracy_binding_note(*simulation, guard).c_str(),
                  warn_only ? " (--on-accuracy-error warn: exit 0)" : "");
     if (!warn_only) return kExitAccuracy;
   }

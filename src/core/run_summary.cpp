@@ -15,7 +15,13 @@ std::string local_error_estimate_summary(const StepStatistics& statistics, const
 }
 
 std::string step_control_summary(const IntegratorSettings& settings, const StepStatistics& statistics) {
-  if (settings.step_control == StepControl::kFixed) return "";
+  if (settings.step_control == StepControl::kFixed) {
+    if (statistics.rejected_steps == 0) return "";
+    char text[200];
+    std::snprintf(text, sizeof text, "fixed steps: %llu taken in substeps (h/2 ... h/64) where the whole step failed",
+                  static_cast<unsigned long long>(statistics.rejected_steps));
+    return text;
+  }
   const char* control = to_string(settings.step_control);
   char text[320];
   if (statistics.internal_steps == 0) {
@@ -88,7 +94,19 @@ std::string run_summary(const Simulation& simulation, const AccuracyGuard& guard
   if (!control.empty()) text += "  " + control + "\n";
   const std::string actuators = actuator_summary(simulation);
   if (!actuators.empty()) text += "  actuators: " + actuators + "\n";
-  text += "  accuracy: " + guard.summary() + "\n";
+  text += "  accuracy: " + guard.summary() + accuracy_binding_note(simulation, guard) + "\n";
+  return text;
+}
+
+std::string accuracy_binding_note(const Simulation& simulation, const AccuracyGuard& guard) {
+  const IntegratorSettings& settings = simulation.scene().integrator;
+  if (settings.step_control == StepControl::kFixed || guard.level() != AccuracyLevel::kError) return "";
+  char text[400];
+  std::snprintf(text, sizeof text,
+                " (under a step control the scene's accuracy limits judge every row, those between the member's "
+                "steps from its dense output too, and may bind before position_tolerance %.3g m does: a smaller "
+                "tolerance or looser limits in the scene's accuracy section)",
+                settings.position_tolerance);
   return text;
 }
 

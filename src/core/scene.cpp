@@ -11,6 +11,7 @@
 #include "birkhoff_cart/core/closest_name.h"
 #include "birkhoff_cart/core/effect_library.h"
 #include "birkhoff_cart/core/cart_binding/integrator_registry.h"
+#include "birkhoff_cart/core/integrators/adaptive_refusal.h"
 #include "birkhoff_cart/core/step_schedule.h"
 #include "scene_reader.h"
 
@@ -132,12 +133,13 @@ IntegratorSettings read_integrator(const SceneReader& reader, const YAML::Node& 
     const std::string control = to_string(settings.step_control);
     const bool offered = settings.step_control == StepControl::kReversible ? integrator_entry(settings.name).reversible()
                                                                            : integrator_entry(settings.name).adaptive();
+    if (!offered && settings.step_control == StepControl::kReversible) {
+      reader.fail(key + ".step_control", "'" + control + "' is for the symmetric Birkhoffian members (" +
+                                             name_list(reversible_integrator_names()) + "), not '" + settings.name + "'");
+    }
     if (!offered) {
-      const bool reversible = settings.step_control == StepControl::kReversible;
-      reader.fail(key + ".step_control",
-                  "'" + control + "' is for " + (reversible ? "the symmetric Birkhoffian members (" : "(") +
-                      name_list(reversible ? reversible_integrator_names() : adaptive_integrator_names()) + "), not '" +
-                      settings.name + "'");
+      const std::string refusal = adaptive_refusal_message(settings.name);
+      reader.fail(key + ".step_control", refusal.substr(refusal.find('\'')));  // "'adaptive' is for (…), not …"
     }
     if (!reader.has(node, "position_tolerance")) {
       reader.fail(key + ".position_tolerance", "is required with 'step_control: " + control +

@@ -1,5 +1,6 @@
 #include "birkhoff_cart/core/simulation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -8,6 +9,7 @@
 #include "birkhoff_cart/core/actuators/steering_end_stops.h"
 #include "birkhoff_cart/core/actuators/torque_actuator.h"
 #include "birkhoff_cart/core/effect_library.h"
+#include "birkhoff_cart/core/accuracy_floors.h"
 #include "birkhoff_cart/core/reference_solution.h"
 #include "birkhoff_cart/core/restart_state.h"
 #include "birkhoff_cart/core/singular_steering.h"
@@ -48,10 +50,35 @@ IntegratorSettings integrator_settings(const Scene& scene) {
   }
   IntegratorSettings settings = scene.integrator;
   if (settings.tolerance_horizon == 0.0) settings.tolerance_horizon = scene.duration;
+  const double floor = position_tolerance_floor(scene);  // [m]
+  if (settings.step_control != StepControl::kFixed && settings.position_tolerance > 0.0 &&
+      settings.position_tolerance < floor) {
+    std::ostringstream message;
+    message << "integrator.position_tolerance " << settings.position_tolerance << " m is below what double precision "
+            << "reaches on this scene: " << floor << " m (1000 machine epsilons times its length scale; "
+            << "docs/accuracy.md)";
+    throw std::invalid_argument(message.str());
+  }
   return settings;
 }
 
 }  // namespace
+
+double scene_length_scale(const Scene& scene) {
+  const CartState& start = scene.initial_state;
+  const double travel = std::abs(start.forward_speed) * scene.duration;  // [m]
+  return std::max({1.0, scene.cart.wheelbase, std::abs(start.x), std::abs(start.y), travel});
+}
+
+double position_tolerance_floor(const Scene& scene) {
+  return 1000.0 * std::numeric_limits<double>::epsilon() * scene_length_scale(scene);
+}
+
+double shadow_reference_resolution(const Scene& scene) {
+  const ReferenceSettings& reference = scene.reference;
+  if (reference.kind != ReferenceSettings::Kind::kShadowRun || reference.shadow.name != "dopri5") return 0.0;
+  return 100.0 * reference.shadow.tolerance * scene_length_scale(scene);
+}
 
 Simulation::Simulation(const Scene& scene)
     : scene_(scene),

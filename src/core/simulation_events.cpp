@@ -131,6 +131,7 @@ void Simulation::take_step_with_events(double next_time) {
       for (TorqueActuator* actuator : actuators) {
         if (actuator) end = std::min(end, actuator->next_kink_after(current.time));
       }
+      const Contact held = stops ? stops->contact() : Contact::kNone;  // the contact over this sub-step
       CartState next = sub_step(current, end - current.time, end);
       if (stops && stops->contact() == Contact::kNone && stops->penetration(next.steering_angle) > 0.0) {
         // (S1) impact: the instant where |χ| = χ_s, then the jump of ω.
@@ -163,6 +164,9 @@ void Simulation::take_step_with_events(double next_time) {
           record_event(next);
         }
       }
+      // (S2) a held axle does not move: χ stays on its stop exactly, whatever the step's round-off
+      // (a state past the stop would be refused as a restart, e.g. a pose request, docs/actuators.md §3).
+      if (held != Contact::kNone && stops->penetration(next.steering_angle) > 0.0) stops->hold_on_stop(next, held);
       current = next;
     }
     // The reference follows through the events: to each, restarted from the simulation's state there.

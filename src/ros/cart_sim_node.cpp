@@ -41,7 +41,7 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   }
   Scene scene;
   start_part("cannot load scene: ", [&] { scene = load_scene(parameters_.scene_path); });
-  apply_integrator_overrides(parameters_, scene.integrator);
+  start_part("bad parameter: ", [&] { apply_integrator_overrides(parameters_, scene.integrator); });
   start_part("cannot build the simulation of " + parameters_.scene_path + ": ", [&] {
     run_ = std::make_unique<GuardedRun>(scene, OutputInstants::kCaller);  // checked at the publish instants
   });

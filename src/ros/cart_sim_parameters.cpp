@@ -71,7 +71,15 @@ void apply_integrator_overrides(const CartSimParameters& parameters, IntegratorS
   if (!parameters.integrator.empty()) settings.name = parameters.integrator;
   if (parameters.step_size > 0.0) settings.step_size = parameters.step_size;
   if (!parameters.step_control.empty()) settings.step_control = parse_step_control(parameters.step_control);
-  if (parameters.position_tolerance > 0.0) settings.position_tolerance = parameters.position_tolerance;
+  if (parameters.position_tolerance > 0.0) {
+    if (settings.step_control == StepControl::kFixed) {
+      throw std::invalid_argument("~position_tolerance " + format_seconds(parameters.position_tolerance) +
+                                  " m is the position error for a step control, and the run steps at fixed steps "
+                                  "(scene " + parameters.scene_path +
+                                  "): give ~step_control adaptive or reversible with it, or leave it out");
+    }
+    settings.position_tolerance = parameters.position_tolerance;
+  }
 }
 
 std::string format_seconds(double value) {

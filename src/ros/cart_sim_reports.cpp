@@ -12,6 +12,7 @@
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 
+#include "birkhoff_cart/core/accuracy_floors.h"
 #include "birkhoff_cart/core/run_summary.h"
 #include "birkhoff_cart/ros/accuracy_reporting.h"
 
@@ -176,6 +177,12 @@ void CartSimReports::write_summary(const std::string& outcome) {
        << " N m s, max constraint residual = " << diagnostics.max_constraint_residual << " m/s";
   if (diagnostics.has_reference) {
     text << ", reference position error = " << diagnostics.reference_position_error << " m";
+    // A reference judges only errors ≥ 10× its own (docs/accuracy.md §4.3).
+    const double resolution = shadow_reference_resolution(run_.simulation.scene());  // [m]; 0: not estimated
+    if (resolution > 0.0 && !(diagnostics.reference_position_error >= 10.0 * resolution)) {
+      text << " (not resolved: the shadow reference is itself off by up to ~" << resolution
+           << " m, so it judges errors above ~" << 10.0 * resolution << " m only)";
+    }
   }
   text << ". Steps: " << run_.work.steps() << " (" << run_.simulation.statistics().newton_iterations_total
        << " Newton iterations since the last start), wall time " << wall_time << " s (stepping "
@@ -184,7 +191,10 @@ void CartSimReports::write_summary(const std::string& outcome) {
        << ". Published instants: " << run_.work.published_instants() << "."
        << ros_accuracy::summary_sentence(run_.guard, run_.simulation.statistics(), run_.simulation.integrator_name());
   const std::string control = step_control_summary(run_.simulation.scene().integrator, run_.simulation.statistics());
-  if (!control.empty()) text << " Step size: the output step h; " << control << ".";
+  if (!control.empty()) {
+    const bool fixed = run_.simulation.scene().integrator.step_control == StepControl::kFixed;
+    text << (fixed ? " " : " Step size: the output step h; ") << control << ".";
+  }
   if (run_.parameters.lockstep) text << " Lockstep timeouts: " << run_.lockstep_timeouts << ".";
   if (run_.odometry_sensor && run_.odometry_sensor->estimate().time == state.time) {  // read at the last instant
     text << " " << odometry_drift_line(*run_.odometry_sensor, state, run_.simulation.model()) << ".";

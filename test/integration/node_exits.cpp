@@ -4,6 +4,8 @@
 //  - The summary's real-time factor is scene time over the wall time *not paused*.
 //  - A scene whose times reach ROS time's end (2^32 s) is refused at start with exit 2, by name
 //    (it aborted in ros::Time with the bag unfinished).
+//  - A ~position_tolerance on a run at fixed steps (no ~step_control, none in the scene) is refused
+//    at start with exit 2, by name (it was silently ignored).
 //  - A ~reset while recording closes the run's bag and records the next run to <stem>_run2.bag:
 //    no bag holds the overlapping times of two runs.
 //  - sim.launch record:=false sets ~bag_path to "" (a ~bag_path left on the master by an earlier
@@ -120,6 +122,24 @@ TEST(NodeExits, SceneTimesBeyondRosTimeAreRefusedByName) {
   EXPECT_FALSE(file_exists(bag) || file_exists(bag + ".active")) << "a refused node opened its bag";
   for (const std::string& path : {scene, log, bag, bag + ".active"}) std::remove(path.c_str());
   ros::NodeHandle().deleteParam("/exits_late");
+}
+
+TEST(NodeExits, APositionToleranceWithoutAStepControlIsRefusedByName) {
+  const std::string bag = scratch("no_control.bag");
+  const std::string log = scratch("no_control.log");
+  const pid_t pid = start_cart_sim(
+      {"__name:=exits_no_control", "_scene:=" + scene_parameter(), "_fast:=true", "_position_tolerance:=1e-6",
+       "_bag_path:=" + bag},
+      log);
+  ASSERT_GT(pid, 0);
+  const int status = wait_exit(pid, kWaitTimeout);
+  const std::string output = read_file(log);
+  EXPECT_EQ(status, 2) << output;
+  EXPECT_NE(output.find("~position_tolerance"), std::string::npos) << output;
+  EXPECT_NE(output.find("~step_control"), std::string::npos) << output;
+  EXPECT_FALSE(file_exists(bag) || file_exists(bag + ".active")) << "a refused node opened its bag";
+  for (const std::string& path : {log, bag, bag + ".active"}) std::remove(path.c_str());
+  ros::NodeHandle().deleteParam("/exits_no_control");
 }
 
 /// Odometry stamps of a bag, in bag order [s].

@@ -18,7 +18,7 @@ struct StepStatistics {
   std::uint64_t internal_steps = 0;                                          ///< grid steps taken
   double internal_step_min = std::numeric_limits<double>::infinity();        ///< smallest |h| [s]
   double internal_step_max = 0.0;                                            ///< largest |h| [s]
-  std::uint64_t rejected_steps = 0;  ///< attempts the adaptive control rejected (adaptive_step_control.h); the reversible control's restarts with a smaller ε
+  std::uint64_t rejected_steps = 0;  ///< attempts the adaptive control rejected (adaptive_step_control.h); the reversible control's restarts with a smaller ε; at fixed steps, the steps whose whole step failed and that were taken in substeps of h/2, h/4, … (cart_stepper_adapter.h)
   double control_fictive_step = std::numeric_limits<double>::quiet_NaN();    ///< the reversible control's ε [rad]
 
   // The local error estimate (docs/accuracy.md): per step, the weighted max-norm

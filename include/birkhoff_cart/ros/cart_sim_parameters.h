@@ -57,7 +57,8 @@ const std::vector<std::string>& cart_sim_parameter_names();
 CartSimParameters load_parameters(const ros::NodeHandle& private_node);
 
 /// The integrator settings the parameters override (~integrator, ~step_size, ~step_control,
-/// ~position_tolerance), each when given.
+/// ~position_tolerance), each when given. Throws std::invalid_argument for a position tolerance
+/// asked of a run at fixed steps (no control would hold it).
 void apply_integrator_overrides(const CartSimParameters& parameters, IntegratorSettings& settings);
 
 /// `value` [s] with 10 significant digits, for log lines and service answers.

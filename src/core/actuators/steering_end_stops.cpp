@@ -74,4 +74,9 @@ SteeringEndStops::Contact SteeringEndStops::impact(CartState& state, double rest
   return side;
 }
 
+void SteeringEndStops::hold_on_stop(CartState& state, Contact side) const {
+  state.steering_angle = side == Contact::kUpper ? settings_.angle : -settings_.angle;
+  state.steering_angle_low = 0.0;
+}
+
 }  // namespace birkhoff_cart

@@ -18,7 +18,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <sstream>
+#include <string>
 
 #include "birkhoff_cart/core/cart_binding/carried_state.h"
 #include "birkhoff_cart/core/effects.h"
@@ -42,6 +45,10 @@ class AdaptiveCartStepperAdapter final
   using Base::instants_;
   using Base::output_;
   using Base::system_;
+  /// The work limit: internal steps between two output instants (as dopri5's, DOPRI5's NMAX).
+  static constexpr std::uint64_t kMaxInternalStepsPerOutput = 100000;
+  /// A failed side step is retried in up to 2^kMaxSideStepHalvings substeps.
+  static constexpr int kMaxSideStepHalvings = 6;
 
  public:
   AdaptiveCartStepperAdapter(const Stepper& stepper, const IntegratorSettings& settings, const CartModel& model,
@@ -58,6 +65,7 @@ class AdaptiveCartStepperAdapter final
     control.error_per_unit_step = aimed_error_per_unit_step<AdaptiveToleranceProportionality<Stepper>>(asked);
     // The stage solve stops at κ·τ·h of the asked τ (B.49), not of the aim.
     control.stage_change_fraction *= asked / control.error_per_unit_step;
+    control.max_steps_per_advance = kMaxInternalStepsPerOutput;
     return control;
   }
 
@@ -90,7 +98,16 @@ class AdaptiveCartStepperAdapter final
   /// grid point itself when it is at `target`, else the dense output.
   void advance(double target, StepStatistics& statistics) {
     const bool land = instants_.exact_at(target);
+    std::uint64_t taken = 0;
     while (control_.time() < target) {
+      if (++taken > control_.settings().max_steps_per_advance) {
+        std::ostringstream message;
+        message.precision(17);
+        message << "work limit: more than " << control_.settings().max_steps_per_advance
+                << " internal steps from t = " << control_.time() << " s to the output instant t = " << target
+                << " s (position tolerance " << position_tolerance_ << " m; a looser tolerance, or a singular point)";
+        throw StepError(message.str());
+      }
       double limit = land ? target : instants_.next_landing_after(control_.time());  // +inf: none
       const double kink = system_.non_birkhoffian_force_enabled() ? effects_->next_kink_after(control_.time())
                                                                   : std::numeric_limits<double>::infinity();
@@ -118,15 +135,41 @@ class AdaptiveCartStepperAdapter final
   }
 
   /// The state at `target` by one step of the member from the grid point before it: exact to the
-  /// member's order where the dense output's estimate says it is not.
+  /// member's order where the dense output's estimate says it is not. A side step whose stage solve
+  /// fails or lands on a spurious root (non-finite, or the energy balance broken) is retried in 2,
+  /// 4, … 2^kMaxSideStepHalvings substeps, as the control retries a rejected attempt smaller.
   void side_step(double target, StepStatistics& statistics) {
-    output_.point = control_.previous();
-    output_.turns = control_.previous_turns();
-    Memory memory;  // no stage history: an explicit start
-    const double start = control_.previous_time();
-    system_traits::begin_step(system_, start);
-    control_.stepper().advance_compensated(system_, output_.point, memory, start, target - start, statistics);
-    output_.reduce_angles();
+    const double start = control_.previous_time();  // [s]
+    std::string last;
+    for (int halvings = 0; halvings <= kMaxSideStepHalvings; ++halvings) {
+      const int pieces = 1 << halvings;
+      output_.point = control_.previous();
+      output_.turns = control_.previous_turns();
+      Memory memory;  // no stage history: an explicit start
+      try {
+        for (int k = 1; k <= pieces; ++k) {
+          const double from = start + (target - start) * static_cast<double>(k - 1) / pieces;           // [s]
+          const double to = k == pieces ? target : start + (target - start) * static_cast<double>(k) / pieces;  // [s]
+          const CompensatedPoint<System> before = output_.point;
+          system_traits::begin_step(system_, from);
+          control_.stepper().advance_compensated(system_, output_.point, memory, from, to - from, statistics);
+          const bool finite = output_.point.z.allFinite() && output_.point.y.allFinite();
+          if (!finite || !stepper_checks::energy_balance_holds(system_.model(), cart_state(before, from),
+                                                               cart_state(output_.point, to))) {
+            throw StepError("a non-finite state or a broken energy balance (a spurious root)");
+          }
+        }
+        output_.reduce_angles();
+        return;
+      } catch (const StepError& error) {
+        last = error.what();
+      }
+    }
+    std::ostringstream message;
+    message.precision(17);
+    message << "the side step to the output instant t = " << target << " s failed whole and in 2 to "
+            << (1 << kMaxSideStepHalvings) << " substeps; the last: " << last;
+    throw StepError(message.str());
   }
 
   /// A grid point's CartState at time t [s] (its angles as carried: the balance does not read turns).

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "birkhoff_cart/core/closest_name.h"
+#include "birkhoff_cart/core/integrators/adaptive_refusal.h"
 #include "step_checks.h"
 
 namespace birkhoff_cart {
@@ -32,8 +33,7 @@ std::unique_ptr<CartStepper> make_cart_stepper(const IntegratorSettings& setting
   if (settings.step_control == StepControl::kAdaptive) {
     const IntegratorEntry* member = find_integrator(settings.name);
     if (member == nullptr || !member->adaptive()) {
-      throw std::invalid_argument("step_control 'adaptive' is for (" +
-                                  name_list(adaptive_integrator_names()) + "), not '" + settings.name + "'");
+      throw std::invalid_argument(adaptive_refusal_message(settings.name));
     }
     return member->make_adaptive(settings, model, effects);
   }

@@ -134,11 +134,16 @@ class Dopri5RunCartStepper final : public CartStepper {
             << "): " << why;
     throw StepError(message.str());
   }
+  /// Is `a` the state this run handed out as `b` (every field but the time, bit for bit)? The time
+  /// is left out: callers set t = t₀ + n·h themselves (simulation.cpp), which may differ from the
+  /// run's tₖ + h by an ulp; a restart there would start the run again from the dense output's
+  /// state at every such output instant, and the error would follow the output rate.
   static bool same_state(const CartState& a, const CartState& b) {
-    return a.time == b.time && a.x == b.x && a.y == b.y && a.heading == b.heading &&
+    return a.x == b.x && a.y == b.y && a.heading == b.heading &&
            a.steering_angle == b.steering_angle && a.wheel_spin_angle == b.wheel_spin_angle &&
            a.arc_length == b.arc_length && a.forward_speed == b.forward_speed && a.steering_rate == b.steering_rate &&
-           a.applied_work == b.applied_work && a.steering_impulse == b.steering_impulse;
+           a.applied_work == b.applied_work && a.steering_impulse == b.steering_impulse &&
+           a.steering_angle_low == b.steering_angle_low && a.heading_low == b.heading_low;
   }
 
   const std::string name_ = DormandPrince5::name();

@@ -15,6 +15,7 @@
 #include "birkhoff_cart/core/cart_birkhoffian.h"
 #include "birkhoff_cart/core/closest_name.h"
 #include "birkhoff_cart/core/cart_binding/carried_state.h"
+#include "birkhoff_cart/core/integrators/adaptive_refusal.h"
 #include "birkhoff_cart/core/integrators/integrator_members.h"
 #include "adaptive_cart_stepper.h"
 #include "cart_stepper_adapter.h"
@@ -95,7 +96,13 @@ std::unique_ptr<CartStepper> adaptive_dopri5(const IntegratorSettings& settings,
   // A tenth of the position tolerance per second of the horizon: measured on the shipped scenes, the
   // delivered error then stays within 10× of the tolerance (the default scene's 60 s came closest).
   const double per_step = 0.1 * settings.position_tolerance / settings.tolerance_horizon;  // [-]
-  return std::make_unique<Dopri5RunCartStepper>(std::max(per_step, DormandPrince5::kMinTolerance), model, effects);
+  if (per_step < DormandPrince5::kMinTolerance) {
+    throw std::invalid_argument("step_control 'adaptive': dopri5 cannot reach position_tolerance " +
+                                std::to_string(settings.position_tolerance) + " m over " +
+                                std::to_string(settings.tolerance_horizon) +
+                                " s (its local tolerance would fall below 10 machine epsilons)");
+  }
+  return std::make_unique<Dopri5RunCartStepper>(per_step, model, effects);
 }
 
 /// The adaptive step control is offered to the members with their own local error estimate: the
@@ -130,7 +137,7 @@ IntegratorEntry registry_row(const IntegratorMember<Stepper>& member) {
   row.description = member.description;
   row.make_fixed = fixed_step<Stepper>;
   row.make_reversible = reversible_factory<Stepper>();
-  row.make_adaptive = adaptive_factory<Stepper>();
+  row.make_adaptive = member.adaptive_refusal == nullptr ? adaptive_factory<Stepper>() : nullptr;
   row.vector_stages = StagesTogether<Stepper>::value;
   return row;
 }
@@ -190,6 +197,22 @@ std::vector<std::string> adaptive_integrator_names() {
     if (entry.adaptive()) names.emplace_back(entry.name);
   }
   return names;
+}
+
+const char* adaptive_refusal(const std::string& name) {
+  const char* reason = nullptr;
+  std::apply(
+      [&](const auto&... member) {
+        ((name == std::decay_t<decltype(member)>::Type::name() ? (reason = member.adaptive_refusal) : nullptr), ...);
+      },
+      kIntegratorMembers);
+  return reason;
+}
+
+std::string adaptive_refusal_message(const std::string& name) {
+  std::string message = "step_control 'adaptive' is for (" + name_list(adaptive_integrator_names()) + "), not '" + name + "'";
+  if (const char* reason = adaptive_refusal(name)) message += std::string(": ") + reason;
+  return message;
 }
 
 }  // namespace birkhoff_cart

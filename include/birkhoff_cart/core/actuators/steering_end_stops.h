@@ -57,6 +57,10 @@ class SteeringEndStops {
   Contact impact(CartState& state) const { return impact(state, settings_.restitution); }
   Contact impact(CartState& state, double restitution) const;
 
+  /// While held on stop `side` (S2: ω̇2 = 0 from ω2 = 0): χ set onto the stop exactly, where a
+  /// step's round-off carried it past (by ~1e-15 rad; the energy it moves is below round-off).
+  void hold_on_stop(CartState& state, Contact side) const;
+
  private:
   SteeringEndStopSettings settings_;
   const CartModel* model_;
