@@ -88,6 +88,8 @@ USES_ROS = re.compile(r"\b(roslaunch|rostopic|rosservice|rosnode|rosparam|roswtf
                       r"rosrun birkhoff_cart (teleop_keyboard|nodelet_manager|cart_sim\b|cmd_vel_controller|"
                       r"steering_driver))")
 USES_DISPLAY = re.compile(r"\brviz\b")
+# A measured figure in shown output: a decimal, a power of ten, or a count of three digits or more.
+FIGURE = re.compile(r"\d\.\d|\d[eE][-+]?\d|\b\d{3,}\b")
 SHELL_STATE = re.compile(r"^(source\s|\.\s|cd\s|export\s|[A-Za-z_][A-Za-z0-9_]*=)")
 
 
@@ -195,6 +197,26 @@ def marker_above(lines, fence_index):
 
 def default_pages(root=REPO):
     return [root / "README.md"] + sorted((root / "docs").glob("*.md"))
+
+
+def shows_figures(block):
+    """Does a console or pycon block show output that holds a measured figure? Those blocks print
+    what the right-hand sides' bits decide (errors, evaluation counts): the bit-sensitive ones."""
+    return block.language in ("console", "pycon") and any(
+        FIGURE.search(line) for _, expected in commands_of(block) for line in expected)
+
+
+def figure_blocks(blocks):
+    """The command blocks that show figures, with the ROS-free command blocks above them on their
+    pages (a later block may use the files an earlier one made), in page order: the doc test's
+    bit-sensitive share, which CI runs again as another CPU (CMakeLists.txt)."""
+    last_figure = {}
+    for block in blocks:
+        if block.runs and not block.marker and shows_figures(block):
+            last_figure[block.page] = max(last_figure.get(block.page, 0), block.line)
+    return [block for block in blocks
+            if block.runs and block.line <= last_figure.get(block.page, 0)
+            and (shows_figures(block) or not USES_ROS.search(block.text))]
 
 
 def commands_of(block):

@@ -32,6 +32,8 @@ packages=(
   # cmd_vel_controller's run-time settings (cfg/CmdVelController.cfg; `rosrun dynamic_reconfigure dynparam`)
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   libboost-dev libyaml-cpp-dev libeigen3-dev googletest libgtest-dev
+  # the right-hand sides' sin, cos, tanh, exp, pow with the same bits on every CPU (deterministic_math.h)
+  libsleef-dev
   python3-matplotlib python3-numpy
   # the study runner (scripts/study): Dask distributed, its local cluster and the row tables
   python3-distributed python3-dask python3-pandas python3-yaml

@@ -93,7 +93,7 @@ std::string integrator_table() {
   std::string table =
       "Integrators (--integrator NAME; docs/integrators.md). p: the order; symmetric: a time-symmetric\n"
       "step map; reversible, adaptive: takes --step-control reversible, adaptive; vector: evaluates its\n"
-      "stages together, with one vector sin/cos where the CPU has AVX2.\n"
+      "stages together, with one vector sin/cos where the CPU has AVX.\n"
       "  NAME                p  symmetric  reversible  adaptive  vector  kind                     scheme\n";
   for (const birkhoff_cart::IntegratorEntry& member : members) {
     char line[220];

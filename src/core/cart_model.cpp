@@ -1,6 +1,7 @@
 #include "birkhoff_cart/core/cart_model.h"
 
 #include "birkhoff_cart/core/angle_reduction.h"
+#include "birkhoff_cart/core/deterministic_math.h"
 
 #include <cmath>
 #include <sstream>
@@ -38,8 +39,8 @@ double CartModel::steering_momentum(const CartState& state) const {
 }
 
 Eigen::Vector2d CartModel::rear_axle_midpoint(const CartState& state) const {
-  return {state.x - parameters_.wheelbase * std::cos(state.heading),
-          state.y - parameters_.wheelbase * std::sin(state.heading)};
+  return {state.x - parameters_.wheelbase * deterministic::cos(state.heading),
+          state.y - parameters_.wheelbase * deterministic::sin(state.heading)};
 }
 
 Eigen::Matrix<double, 6, 1> CartModel::constraint_residuals(const CartParameters& p,
@@ -49,12 +50,12 @@ Eigen::Matrix<double, 6, 1> CartModel::constraint_residuals(const CartParameters
   const double chi = q(3);
   const double front = theta + chi;
   const double x_rate = v(0), y_rate = v(1), heading_rate = v(2), steering_rate = v(3);
-  const double along_rear = x_rate * std::cos(theta) + y_rate * std::sin(theta);
-  const double along_front = x_rate * std::cos(front) + y_rate * std::sin(front);
+  const double along_rear = x_rate * deterministic::cos(theta) + y_rate * deterministic::sin(theta);
+  const double along_front = x_rate * deterministic::cos(front) + y_rate * deterministic::sin(front);
   const double front_yaw_rate = heading_rate + steering_rate;
   Eigen::Matrix<double, 6, 1> residual;
-  residual(0) = -x_rate * std::sin(front) + y_rate * std::cos(front);                       // B no side slip
-  residual(1) = -x_rate * std::sin(theta) + y_rate * std::cos(theta) - p.wheelbase * heading_rate;  // A no side slip
+  residual(0) = -x_rate * deterministic::sin(front) + y_rate * deterministic::cos(front);                       // B no side slip
+  residual(1) = -x_rate * deterministic::sin(theta) + y_rate * deterministic::cos(theta) - p.wheelbase * heading_rate;  // A no side slip
   residual(2) = along_rear - p.rear_half_track * heading_rate - p.rear_wheel_radius * v(4);  // wheel 1 rolls
   residual(3) = along_rear + p.rear_half_track * heading_rate - p.rear_wheel_radius * v(5);  // wheel 2 rolls
   residual(4) = along_front - p.front_half_track * front_yaw_rate - p.front_wheel_radius * v(6);  // wheel 3

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "birkhoff_cart/core/cart_model.h"
+#include "birkhoff_cart/core/deterministic_math.h"
 #include "birkhoff_cart/core/effects.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 
@@ -30,7 +31,7 @@ double paper_form_momentum_change_per_step(const Scene& scene) {
   const double p_start = model.momentum(0.0, Vector2<double>(1.0, 0.0))(0);
   for (int k = 0; k < kProbeSteps; ++k) stepper->step(state, settings.step_size, statistics);
   const double p_end = model.momentum(state.steering_angle, Vector2<double>(state.forward_speed, state.steering_rate))(0);
-  return std::pow(p_end / p_start, 1.0 / kProbeSteps) - 1.0;
+  return deterministic::pow(p_end / p_start, 1.0 / kProbeSteps) - 1.0;
 }
 
 double paper_form_momentum_growth(const Scene& scene, double duration) {

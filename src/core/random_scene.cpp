@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "birkhoff_cart/core/deterministic_math.h"
 #include "birkhoff_cart/core/simulation.h"
 
 namespace birkhoff_cart {
@@ -18,7 +19,7 @@ class SceneDraw {
   explicit SceneDraw(std::seed_seq& seeds) : engine_(seeds) {}
 
   double uniform(double low, double high) { return std::uniform_real_distribution<double>(low, high)(engine_); }
-  double log_uniform(double low, double high) { return std::exp(uniform(std::log(low), std::log(high))); }
+  double log_uniform(double low, double high) { return deterministic::exp(uniform(deterministic::log(low), deterministic::log(high))); }
   bool chance(double probability) { return uniform(0.0, 1.0) < probability; }
   int integer(int low, int high) { return std::uniform_int_distribution<int>(low, high)(engine_); }
 
@@ -32,15 +33,15 @@ class SceneDraw {
     cart.rear_wheel_radius = log_uniform(0.02, 1.0);              // [m]
     cart.front_wheel_radius = log_uniform(0.02, 1.0);             // [m]
     cart.rear_body_mass = log_uniform(0.1, 2000.0);               // [kg]
-    cart.rear_body_yaw_inertia = cart.rear_body_mass * std::pow(cart.wheelbase, 2) * log_uniform(0.01, 1.0);
+    cart.rear_body_yaw_inertia = cart.rear_body_mass * deterministic::pow(cart.wheelbase, 2) * log_uniform(0.01, 1.0);
     cart.front_axle_mass = log_uniform(0.05, 200.0);              // [kg]
-    cart.front_axle_yaw_inertia = cart.front_axle_mass * std::pow(cart.front_half_track, 2) * log_uniform(0.02, 0.5);
+    cart.front_axle_yaw_inertia = cart.front_axle_mass * deterministic::pow(cart.front_half_track, 2) * log_uniform(0.02, 0.5);
     cart.rear_wheel_mass = log_uniform(0.05, 100.0);              // [kg]
-    cart.rear_wheel_spin_inertia = cart.rear_wheel_mass * std::pow(cart.rear_wheel_radius, 2) * uniform(0.3, 1.0);
-    cart.rear_wheel_yaw_inertia = cart.rear_wheel_mass * std::pow(cart.rear_wheel_radius, 2) * uniform(0.15, 0.6);
+    cart.rear_wheel_spin_inertia = cart.rear_wheel_mass * deterministic::pow(cart.rear_wheel_radius, 2) * uniform(0.3, 1.0);
+    cart.rear_wheel_yaw_inertia = cart.rear_wheel_mass * deterministic::pow(cart.rear_wheel_radius, 2) * uniform(0.15, 0.6);
     cart.front_wheel_mass = log_uniform(0.05, 100.0);             // [kg]
-    cart.front_wheel_spin_inertia = cart.front_wheel_mass * std::pow(cart.front_wheel_radius, 2) * uniform(0.3, 1.0);
-    cart.front_wheel_yaw_inertia = cart.front_wheel_mass * std::pow(cart.front_wheel_radius, 2) * uniform(0.15, 0.6);
+    cart.front_wheel_spin_inertia = cart.front_wheel_mass * deterministic::pow(cart.front_wheel_radius, 2) * uniform(0.3, 1.0);
+    cart.front_wheel_yaw_inertia = cart.front_wheel_mass * deterministic::pow(cart.front_wheel_radius, 2) * uniform(0.15, 0.6);
     return cart;
   }
 

@@ -1,5 +1,6 @@
 #include "birkhoff_cart/core/reference_solution.h"
 
+#include "birkhoff_cart/core/deterministic_math.h"
 #include "birkhoff_cart/core/shadow_reference.h"
 
 #include <cmath>
@@ -48,24 +49,24 @@ class PaperAnalyticReference : public ReferenceSolution {
 };
 
 /// ln tan(t/2) [-], the antiderivative of 1/sin t on (0, π).
-double log_tan_half(double time) { return std::log(std::tan(0.5 * time)); }
+double log_tan_half(double time) { return deterministic::log(deterministic::tan(0.5 * time)); }
 
 }  // namespace
 
 CartState PaperAnalyticSolution::at(double time) const {
   const double t0 = initial.time;
   const double phase = initial.heading - t0;  // φ = θ₀ − t₀ [rad]
-  const double along = (log_tan_half(time) + 2.0 * std::cos(time)) - (log_tan_half(t0) + 2.0 * std::cos(t0));
-  const double across = 2.0 * std::sin(time) - 2.0 * std::sin(t0);
+  const double along = (log_tan_half(time) + 2.0 * deterministic::cos(time)) - (log_tan_half(t0) + 2.0 * deterministic::cos(t0));
+  const double across = 2.0 * deterministic::sin(time) - 2.0 * deterministic::sin(t0);
   CartState state = initial;
   state.time = time;
   state.steering_angle = time;                                             // χ = t
-  state.forward_speed = 1.0 / std::sin(time);                              // ω1 = 1/sin t
+  state.forward_speed = 1.0 / deterministic::sin(time);                              // ω1 = 1/sin t
   state.steering_rate = 1.0;                                               // ω2 = 1
   state.heading = initial.heading + (time - t0);                           // θ̇ = ω1 sin χ / l = 1
   state.arc_length = initial.arc_length + log_tan_half(time) - log_tan_half(t0);  // π̇1 = 1/sin t
-  state.x = initial.x + std::cos(phase) * along - std::sin(phase) * across;
-  state.y = initial.y + std::cos(phase) * across + std::sin(phase) * along;
+  state.x = initial.x + deterministic::cos(phase) * along - deterministic::sin(phase) * across;
+  state.y = initial.y + deterministic::cos(phase) * across + deterministic::sin(phase) * along;
   return state;
 }
 
@@ -73,7 +74,7 @@ bool PaperAnalyticSolution::matches(const CartState& state) {
   const double t = state.time;
   return t > 0.0 && t < M_PI && std::abs(state.steering_angle - t) <= kAnalyticMatchTolerance &&
          std::abs(state.steering_rate - 1.0) <= kAnalyticMatchTolerance &&
-         std::abs(state.forward_speed * std::sin(t) - 1.0) <= kAnalyticMatchTolerance;
+         std::abs(state.forward_speed * deterministic::sin(t) - 1.0) <= kAnalyticMatchTolerance;
 }
 
 std::unique_ptr<ReferenceSolution> make_reference_solution(const Scene& scene, const CartModel& model,

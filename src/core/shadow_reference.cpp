@@ -10,6 +10,7 @@
 
 #include "birkhoff_cart/core/birkhoffian_system.h"
 #include "birkhoff_cart/core/cart_birkhoffian.h"
+#include "birkhoff_cart/core/integrators/odeint_step_adjuster.h"
 #include "cart_binding/cart_joint_rates.h"
 
 namespace birkhoff_cart {
@@ -23,8 +24,7 @@ class DenseShadowReference : public ReferenceSolution {
   DenseShadowReference(const IntegratorSettings& settings, const CartState& initial, const CartModel& model,
                        const EffectSet& effects)
       : settings_(settings), initial_(initial), model_(&model), system_(model, effects),
-        stepper_(odeint::make_dense_output(settings.tolerance, settings.tolerance,
-                                           odeint::runge_kutta_dopri5<Joint>())) {
+        stepper_(deterministic_controlled(settings.tolerance, settings.tolerance, odeint::runge_kutta_dopri5<Joint>())) {
     restart(initial_, settings_.step_size);
   }
 
@@ -95,7 +95,7 @@ class DenseShadowReference : public ReferenceSolution {
   const CartModel* model_;
   CartAutonomousBirkhoffian system_;
   // calc_state() is const in meaning but not in odeint's signature.
-  mutable odeint::result_of::make_dense_output<odeint::runge_kutta_dopri5<Joint>>::type stepper_;
+  mutable odeint::dense_output_runge_kutta<DeterministicControlled<odeint::runge_kutta_dopri5<Joint>>> stepper_;
 };
 
 /// n fixed sub-steps of the shadow integrator per simulator step; the last lands on its time.

@@ -6,11 +6,14 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include "birkhoff_cart/core/deterministic_math.h"
+
 #if defined(__x86_64__)
 #include <immintrin.h>
-// glibc's libmvec, x86-64 vector function ABI: 'd' = AVX2, 4 doubles, one vector argument.
-extern "C" __m256d _ZGVdN4v_sin(__m256d);
-extern "C" __m256d _ZGVdN4v_cos(__m256d);
+// SLEEF's deterministic AVX functions, 4 doubles (sleef.h declares them only to translation units
+// compiled for AVX): the same bits as deterministic::sin and deterministic::cos lane by lane.
+extern "C" __m256d Sleef_cinz_sind4_u10avx(__m256d);
+extern "C" __m256d Sleef_cinz_cosd4_u10avx(__m256d);
 #endif
 
 namespace birkhoff_cart {
@@ -19,7 +22,7 @@ namespace {
 bool cpu_has_vector_path() {
 #if defined(__x86_64__)
   __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return __builtin_cpu_supports("avx");
 #else
   return false;
 #endif
@@ -36,7 +39,7 @@ StageEvaluation initial_stage_evaluation() {
   if (value == "scalar") return StageEvaluation::kScalar;
   if (value == "vector" && available) return StageEvaluation::kVector;
   std::fprintf(stderr, "birkhoff_cart: BIRKHOFF_CART_STAGE_EVALUATION=%s %s; using %s\n", chosen,
-               value == "vector" ? "needs a CPU with AVX2 and FMA" : "is not scalar or vector",
+               value == "vector" ? "needs a CPU with AVX" : "is not scalar or vector",
                to_string(fallback).c_str());
   return fallback;
 }
@@ -51,21 +54,21 @@ StageEvaluation& current_stage_evaluation() {
 
 void sin_cos_scalar(const double* angles, int count, double* sines, double* cosines) {
   for (int i = 0; i < count; ++i) {
-    sines[i] = std::sin(angles[i]);
-    cosines[i] = std::cos(angles[i]);
+    sines[i] = deterministic::sin(angles[i]);
+    cosines[i] = deterministic::cos(angles[i]);
   }
 }
 
 #if defined(__x86_64__)
-__attribute__((target("avx2,fma"))) void sin_cos_avx2(const double* angles, int count, double* sines,
+__attribute__((target("avx"))) void sin_cos_avx(const double* angles, int count, double* sines,
                                                       double* cosines) {
   alignas(32) double lanes[kMaxVectorLanes] = {0.0, 0.0, 0.0, 0.0};
   for (int i = 0; i < count; ++i) lanes[i] = angles[i];
   const __m256d x = _mm256_load_pd(lanes);
   alignas(32) double sine_lanes[kMaxVectorLanes];
   alignas(32) double cosine_lanes[kMaxVectorLanes];
-  _mm256_store_pd(sine_lanes, _ZGVdN4v_sin(x));
-  _mm256_store_pd(cosine_lanes, _ZGVdN4v_cos(x));
+  _mm256_store_pd(sine_lanes, Sleef_cinz_sind4_u10avx(x));
+  _mm256_store_pd(cosine_lanes, Sleef_cinz_cosd4_u10avx(x));
   for (int i = 0; i < count; ++i) {
     sines[i] = sine_lanes[i];
     cosines[i] = cosine_lanes[i];
@@ -88,7 +91,7 @@ StageEvaluation stage_evaluation() { return current_stage_evaluation(); }
 
 void set_stage_evaluation(StageEvaluation evaluation) {
   if (evaluation == StageEvaluation::kVector && !vector_stage_evaluation_available()) {
-    throw std::invalid_argument("stage evaluation 'vector' needs a CPU with AVX2 and FMA; this one has not");
+    throw std::invalid_argument("stage evaluation 'vector' needs a CPU with AVX; this one has not");
   }
   current_stage_evaluation() = evaluation;
 }
@@ -99,7 +102,7 @@ void sin_cos_lanes(const double* angles, int count, double* sines, double* cosin
   ++lanes_calls;
 #if defined(__x86_64__)
   if (current_stage_evaluation() == StageEvaluation::kVector) {
-    sin_cos_avx2(angles, count, sines, cosines);
+    sin_cos_avx(angles, count, sines, cosines);
     return;
   }
 #endif

@@ -7,6 +7,8 @@ and one that runs a fixture page of deliberately broken commands and requires ea
 Run by scripts/run_tests.sh (catkin's run_tests: pytest-test_doc_commands.xml), or after
 `source .ws/devel/setup.bash`: python3 -m pytest test/python/test_doc_commands.py [-k NAME].
 BIRKHOFF_CART_DEVEL names another built devel space (the mutation check's scratch build).
+BIRKHOFF_CART_DOC_BLOCKS=figures keeps only the blocks that show figures and the ROS-free blocks
+above them (doc_commands.figure_blocks): CI runs those again as another CPU (CMakeLists.txt).
 """
 import os
 import pathlib
@@ -23,6 +25,8 @@ DEVEL = pathlib.Path(os.environ.get("BIRKHOFF_CART_DEVEL", REPO / ".ws" / "devel
 FIXTURE = pathlib.Path(__file__).resolve().parent / "doc_fixtures" / "broken_commands.md"
 BLOCKS = [block for page in doc_commands.default_pages(REPO) for block in doc_commands.blocks_of(page, REPO)]
 COMMAND_BLOCKS = [block for block in BLOCKS if block.runs]
+if os.environ.get("BIRKHOFF_CART_DOC_BLOCKS") == "figures":
+    COMMAND_BLOCKS = doc_commands.figure_blocks(COMMAND_BLOCKS)
 
 
 @pytest.fixture(scope="module")

@@ -11,8 +11,10 @@ import pytest
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 NUMERICS = "include/birkhoff_cart/core/integrators"
 # Core headers that know no cart: the system concept, AD scalars, the work counters, angle
-# reduction, and the integrator settings (plain data: names, step size, tolerances).
+# reduction, the elementary functions with the same bits on every CPU, and the integrator settings
+# (plain data: names, step size, tolerances).
 GENERIC_CORE = {
+    "include/birkhoff_cart/core/deterministic_math.h",
     "include/birkhoff_cart/core/autodiff.h",
     "include/birkhoff_cart/core/birkhoffian_system.h",
     "include/birkhoff_cart/core/diagnostics.h",

@@ -65,6 +65,8 @@ SAMPLE = [
     ("very_stiff_hinge", "birkhoff_gauss8_reversible", 0.001),
     ("very_stiff_hinge", "birkhoff_gauss8", 0.005),
 ]
+# glibc's dynamic loader (x86-64), which lists the CPU features glibc uses.
+LOADER = "/lib64/ld-linux-x86-64.so.2"
 # What a measurement's result holds that depends on the machine and its load, not on the build.
 TIMES = {"cpu_median_s", "wall_median_s", "wall_s", "repetitions"}
 
@@ -77,12 +79,10 @@ def page_stage_evaluation():
 
 @pytest.fixture(scope="module")
 def study():
-    # The page's errors are those of its stage-evaluation path (the paths agree to round-off only).
-    path = page_stage_evaluation()
-    os.environ.pop("BIRKHOFF_CART_STAGE_EVALUATION", None)
-    assert path == "scalar" or report.stage_evaluation() == "vector", \
-        "docs/results.md was measured on the vector path, which this CPU lacks (AVX2 and FMA): its rows cannot be reproduced here"
-    os.environ["BIRKHOFF_CART_STAGE_EVALUATION"] = path
+    # The sample runs on the path the environment chooses (BIRKHOFF_CART_STAGE_EVALUATION, else the
+    # CPU's): both give the page's bits (docs/developing.md, "Figures that hold on every machine").
+    page_stage_evaluation()
+    print(f"results sample: stage evaluation {report.stage_evaluation()} (the page's runs: {page_stage_evaluation()})")
     registry = read_registry(str(BIN / "cart_simulate"))
     doc, tasks = load_study(str(STUDY), registry, str(REPO / "config" / "scenes"))
     rows = {row["task_id"]: row for row in latest_rows(read_rows(str(ROWS)))}
@@ -105,6 +105,28 @@ def measured_again(task, reference_row=None):
     if "--repetitions" in argv:
         argv[argv.index("--repetitions") + 1] = "1"
     return work_precision.run(wire, reference_row)
+
+
+def glibc_active_cpu_features(environment):
+    """The CPU feature words glibc uses in a process with this environment (ld.so --list-diagnostics:
+    x86.cpu_features.features[i].active[j]); GLIBC_TUNABLES=glibc.cpu.hwcaps=-FEATURE,... clears bits."""
+    listed = subprocess.run([LOADER, "--list-diagnostics"], env=environment, capture_output=True, text=True, check=True)
+    return [line for line in listed.stdout.splitlines() if re.match(r"x86\.cpu_features\.features\[\w+\]\.active", line)]
+
+
+def test_the_cpu_this_sample_runs_as():
+    """Says what the sample compares on: glibc's CPU features here and the stage-evaluation path.
+    Under GLIBC_TUNABLES (CI's run as another CPU) the features must differ from the machine's own,
+    or the tunable named features this glibc does not know and the run tested nothing new."""
+    here = glibc_active_cpu_features(os.environ)
+    own = glibc_active_cpu_features({k: v for k, v in os.environ.items() if k != "GLIBC_TUNABLES"})
+    masked = sum(a != b for a, b in zip(here, own))
+    tunables = os.environ.get("GLIBC_TUNABLES", "")
+    print(f"results sample: GLIBC_TUNABLES={tunables or '(unset)'}: glibc's active CPU feature words differ from "
+          f"the machine's own in {masked} of {len(own)}; stage evaluation {report.stage_evaluation()}")
+    assert here and len(here) == len(own), "ld.so --list-diagnostics listed no x86 CPU features"
+    if "glibc.cpu.hwcaps" in tunables:
+        assert masked > 0, f"GLIBC_TUNABLES={tunables} masked no CPU feature: this glibc does not know those names"
 
 
 def test_the_page_records_the_commit_it_was_written_from():

@@ -24,6 +24,7 @@
 #include "birkhoff_cart/core/autodiff.h"
 #include "birkhoff_cart/core/birkhoffian_system.h"
 #include "birkhoff_cart/core/cart_model.h"
+#include "birkhoff_cart/core/deterministic_math.h"
 #include "birkhoff_cart/core/effects.h"
 #include "birkhoff_cart/core/state.h"
 #include "birkhoff_cart/core/vector_math.h"
@@ -105,8 +106,8 @@ class CartBirkhoffianBase {
   };
   template <class S>
   static SteeringTrig<S> steering_trig(const S& steering_angle) {
-    using std::cos;
-    using std::sin;
+    using deterministic::cos;
+    using deterministic::sin;
     return {sin(steering_angle), cos(steering_angle)};
   }
 
@@ -124,8 +125,8 @@ class CartBirkhoffianBase {
   /// ṗ from momentum_rate; dM/dχ = [[2 μ1 s c, ν c], [ν c, 0]] from eq. (3.3)).
   template <class S>
   Vector2<S> quasi_acceleration(const Vector<S>& z, const S& t) const {
-    using std::cos;
-    using std::sin;
+    using deterministic::cos;
+    using deterministic::sin;
     const S& chi = z(kSteeringAngleIndex);
     const Vector2<S> omega = quasi_velocity(z);
     const Vector2<S> p_rate = momentum_rate(chi, omega, t);
@@ -147,7 +148,7 @@ class CartBirkhoffianBase {
   /// [1/s] is the slowest rate the steps resolve where the cart neither turns nor accelerates.
   template <class S>
   S squared_step_density(const Vector<S>& z, const S& t, double density_floor) const {
-    using std::sin;
+    using deterministic::sin;
     using std::sqrt;
     const double l = model_->parameters().wheelbase;
     const Vector2<S> omega = quasi_velocity(z);
@@ -168,7 +169,7 @@ class CartBirkhoffianBase {
   /// z alone, even in p (the reversal p ↦ −p leaves it unchanged).
   template <class S>
   S step_density(const Vector<S>& z) const {
-    using std::sin;
+    using deterministic::sin;
     using std::sqrt;
     constexpr double kDensityFloor = 1.0;  // σ₀ [1/s]
     const Vector2<S> omega = quasi_velocity(z);
@@ -428,8 +429,9 @@ class CartPaperBirkhoffian : public CartBirkhoffianBase, public CartStageRates<C
   /// e^{t−tₑ} [-].
   template <class S>
   S conformal_factor(const S& t) const {
-    using std::exp;
-    return exp(t - structure_epoch_);
+    using deterministic::exp;
+    const S since_epoch = t - structure_epoch_;  // [s]
+    return exp(since_epoch);
   }
   /// R = e^{t−tₑ} (p1, p2, 0, 0).
   template <class S>

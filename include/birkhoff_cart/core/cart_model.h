@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 
+#include "birkhoff_cart/core/deterministic_math.h"
 #include "birkhoff_cart/core/parameters.h"
 #include "birkhoff_cart/core/state.h"
 
@@ -46,7 +47,7 @@ class CartModel {
   /// M(χ) = [[μ + μ1 s², ν s], [ν s, l ν]], s = sin χ, so that T* = ½ ωᵀ M ω   (eq. (3.3)).
   template <class Scalar>
   Matrix2<Scalar> mass_matrix(const Scalar& steering_angle) const {
-    using std::sin;
+    using deterministic::sin;
     return mass_matrix_at(Scalar(sin(steering_angle)));
   }
 
@@ -92,8 +93,8 @@ class CartModel {
   template <class Scalar>
   Vector2<Scalar> nonholonomic_force(const Scalar& steering_angle,
                                      const Vector2<Scalar>& quasi_velocity) const {
-    using std::cos;
-    using std::sin;
+    using deterministic::cos;
+    using deterministic::sin;
     const Scalar s = sin(steering_angle);
     const Scalar c = cos(steering_angle);
     return nonholonomic_force_at(s, c, quasi_velocity);
@@ -103,8 +104,8 @@ class CartModel {
   template <class Scalar>
   Scalar kinetic_energy_steering_derivative(const Scalar& steering_angle,
                                             const Vector2<Scalar>& quasi_velocity) const {
-    using std::cos;
-    using std::sin;
+    using deterministic::cos;
+    using deterministic::sin;
     return kinetic_energy_steering_derivative_at(Scalar(sin(steering_angle)), Scalar(cos(steering_angle)),
                                                  quasi_velocity);
   }
@@ -116,8 +117,8 @@ class CartModel {
   template <class Scalar>
   Vector2<Scalar> momentum_rate(const Scalar& steering_angle, const Vector2<Scalar>& quasi_velocity,
                                 const Vector2<Scalar>& generalized_force) const {
-    using std::cos;
-    using std::sin;
+    using deterministic::cos;
+    using deterministic::sin;
     return momentum_rate_at(Scalar(sin(steering_angle)), Scalar(cos(steering_angle)), quasi_velocity,
                             generalized_force);
   }
@@ -136,8 +137,8 @@ class CartModel {
   template <class Scalar>
   Vector2<Scalar> quasi_acceleration(const Scalar& steering_angle, const Vector2<Scalar>& quasi_velocity,
                                      const Vector2<Scalar>& generalized_force) const {
-    using std::cos;
-    using std::sin;
+    using deterministic::cos;
+    using deterministic::sin;
     const Scalar s = sin(steering_angle);
     const Scalar c = cos(steering_angle);
     const Scalar coupling = quasi_velocity(0) * quasi_velocity(1) * c;
@@ -152,8 +153,8 @@ class CartModel {
   template <class Scalar>
   void rim_speed_coefficients(const Scalar& steering_angle, std::array<Scalar, 4>& d1,
                               std::array<double, 4>& d2) const {
-    using std::cos;
-    using std::sin;
+    using deterministic::cos;
+    using deterministic::sin;
     rim_speed_coefficients_at(Scalar(sin(steering_angle)), Scalar(cos(steering_angle)), d1, d2);
   }
   /// The same from s = sin χ, c = cos χ.
@@ -177,8 +178,8 @@ class CartModel {
   template <class Scalar>
   CoordinateRates<Scalar> coordinate_rates(const Scalar& heading, const Scalar& steering_angle,
                                            const Vector2<Scalar>& quasi_velocity) const {
-    using std::cos;
-    using std::sin;
+    using deterministic::cos;
+    using deterministic::sin;
     return coordinate_rates_at(heading, steering_angle, Scalar(sin(steering_angle)), Scalar(cos(steering_angle)),
                                quasi_velocity);
   }
@@ -186,8 +187,8 @@ class CartModel {
   template <class Scalar>
   CoordinateRates<Scalar> coordinate_rates_at(const Scalar& heading, const Scalar& steering_angle, const Scalar& s,
                                               const Scalar& c, const Vector2<Scalar>& quasi_velocity) const {
-    using std::cos;
-    using std::sin;
+    using deterministic::cos;
+    using deterministic::sin;
     CoordinateRates<Scalar> rates;
     const Scalar front_heading = heading + steering_angle;
     rates.x_rate = quasi_velocity(0) * cos(front_heading);

@@ -1,16 +1,18 @@
 // sin and cos of several angles at once, for the stage right-hand sides of the Gauss collocation
 // members (gauss_collocation.h, cart_birkhoffian.h darboux_rates_stages): the s ≤ 4 steering angles
-// of one Newton iteration's stages go through one vector call of glibc's libmvec (_ZGVdN4v_sin,
-// _ZGVdN4v_cos: AVX2, within 4 ulp) instead of s scalar sincos calls, which the iteration waits on
-// one after another. docs/integrators.md, "Stage evaluation".
+// of one Newton iteration's stages go through one vector call of SLEEF's deterministic AVX functions
+// (Sleef_cinz_sind4_u10avx, Sleef_cinz_cosd4_u10avx: within 1 ulp, no FMA) instead of s scalar sin
+// and cos calls, which the iteration waits on one after another. docs/integrators.md, "Stage
+// evaluation".
 //
-// Two paths, chosen at run time (the build runs on any x86-64):
-//  - vector: the AVX2 libmvec call, where the CPU has AVX2 and FMA;
-//  - scalar: std::sin and std::cos lane by lane, bit-identical to the members' scalar right-hand side.
+// Two paths, chosen at run time (the build runs on any x86-64), with the same bits:
+//  - vector: the AVX call, where the CPU has AVX;
+//  - scalar: deterministic::sin and deterministic::cos lane by lane (deterministic_math.h),
+//    bit-identical to the members' scalar right-hand side.
 // The default is vector where the CPU allows it; the environment variable
 // BIRKHOFF_CART_STAGE_EVALUATION=scalar|vector, read once at start, or set_stage_evaluation
-// (tests) chooses. The two paths agree to a few ulp per angle; trajectories to round-off
-// (test/unit/stage_evaluation_test.cpp).
+// (tests) chooses. Both return SLEEF's bits for every angle, so trajectories are the same on both
+// (test/unit/stage_evaluation_test.cpp); the path changes the speed only.
 #pragma once
 
 #include <cstdint>
@@ -26,7 +28,7 @@ enum class StageEvaluation { kScalar, kVector };
 /// "scalar" or "vector".
 std::string to_string(StageEvaluation evaluation);
 
-/// Does this CPU run the vector path (AVX2 and FMA on x86-64)?
+/// Does this CPU run the vector path (AVX on x86-64)?
 bool vector_stage_evaluation_available();
 
 /// The path in use now.

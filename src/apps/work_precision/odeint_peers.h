@@ -18,6 +18,7 @@
 
 #include "bench_scene.h"
 #include "birkhoff_cart/core/cart_birkhoffian.h"
+#include "birkhoff_cart/core/integrators/odeint_step_adjuster.h"
 #include "birkhoff_cart/core/simulation.h"
 #include "measurement.h"
 #include "ours.h"
@@ -153,10 +154,10 @@ RunRecord measure_odeint_typed(const BenchScene& bench, const std::string& metho
         e.checkpoints.push_back(checkpoint_error(bench, j, joint_to_cart_state(system, state, t), e.max_energy_residual));
       };
       if (method == "odeint_dopri5") {
-        auto stepper = odeint::make_controlled(tolerance, tolerance, odeint::runge_kutta_dopri5<Joint>());
+        auto stepper = deterministic_controlled(tolerance, tolerance, odeint::runge_kutta_dopri5<Joint>());
         integrate_through_checkpoints(stepper, rates, x, t0, bench.checkpoint_times, 1e-3, observe, at_checkpoint);
       } else if (method == "odeint_rkf78") {
-        auto stepper = odeint::make_controlled(tolerance, tolerance, odeint::runge_kutta_fehlberg78<Joint>());
+        auto stepper = deterministic_controlled(tolerance, tolerance, odeint::runge_kutta_fehlberg78<Joint>());
         integrate_through_checkpoints(stepper, rates, x, t0, bench.checkpoint_times, 1e-3, observe, at_checkpoint);
       } else if (method == "odeint_bulirsch_stoer") {
         odeint::bulirsch_stoer<Joint> stepper(tolerance, tolerance);

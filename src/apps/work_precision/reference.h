@@ -64,7 +64,7 @@ inline ReferenceRun extended_precision_run(const BenchScene& bench, const std::s
   };
   const double w0 = wall_seconds();
   if (stepper_name == "rkf78") {
-    auto stepper = odeint::make_controlled(tolerance, tolerance, odeint::runge_kutta_fehlberg78<Joint, S>());
+    auto stepper = deterministic_controlled(tolerance, tolerance, odeint::runge_kutta_fehlberg78<Joint, S>());
     integrate_through_checkpoints(stepper, rates, x, t0, bench.checkpoint_times, S(1e-3), observe, keep);
   } else if (stepper_name == "bulirsch_stoer") {
     odeint::bulirsch_stoer<Joint, S> stepper(tolerance, tolerance);

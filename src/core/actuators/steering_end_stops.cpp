@@ -1,5 +1,6 @@
 // SteeringEndStops: impact (S1), holding reaction (S2) and release test (S3) of docs/actuators.md §3.
 #include "birkhoff_cart/core/actuators/steering_end_stops.h"
+#include "birkhoff_cart/core/deterministic_math.h"
 
 #include <cmath>
 #include <sstream>
@@ -28,8 +29,8 @@ SteeringEndStops::SteeringEndStops(const SteeringEndStopSettings& settings, cons
 void SteeringEndStops::add_reaction(const EffectInput& input, GeneralizedForce& total) const {
   if (contact_ == Contact::kNone) return;
   const ReducedInertia& inertia = model_->inertia();
-  const double s = std::sin(input.steering_angle);
-  const double c = std::cos(input.steering_angle);
+  const double s = deterministic::sin(input.steering_angle);
+  const double c = deterministic::cos(input.steering_angle);
   const double w1 = input.forward_speed;  // ω1 [m/s]
   const double w2 = input.steering_rate;  // ω2 [rad/s]
   const double m11 = inertia.mu + inertia.mu1 * s * s;  // [kg]

@@ -1,5 +1,6 @@
 // TorqueActuator: the closed-form response of docs/actuators.md eqs. (A1)–(A5).
 #include "birkhoff_cart/core/actuators/torque_actuator.h"
+#include "birkhoff_cart/core/deterministic_math.h"
 
 #include <algorithm>
 #include <cmath>
@@ -99,10 +100,10 @@ double TorqueActuator::hold_response(double t0, double applied0, double target, 
     // (A4) the lag would exceed R: ramp at R until |target − τ| = R T, then the lag from there.
     const double ramp = (std::abs(error) - rate * lag) / rate;  // duration [s]
     if (elapsed <= ramp) return applied0 + direction * rate * elapsed;
-    return target - direction * rate * lag * std::exp(-(elapsed - ramp) / lag);
+    return target - direction * rate * lag * deterministic::exp(-(elapsed - ramp) / lag);
   }
   // (A2) first-order lag: τ = u − (u − τ0) e^{−(t − t0)/T}.
-  return target - error * std::exp(-elapsed / lag);
+  return target - error * deterministic::exp(-elapsed / lag);
 }
 
 double TorqueActuator::ramp_end(double t0, double applied0, double target) const {

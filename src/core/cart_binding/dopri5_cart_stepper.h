@@ -25,6 +25,7 @@
 #include "birkhoff_cart/core/integrator_settings.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/integrators/dopri5.h"
+#include "birkhoff_cart/core/integrators/odeint_step_adjuster.h"
 #include "cart_joint_rates.h"
 #include "output_instants.h"
 #include "step_checks.h"
@@ -35,7 +36,7 @@ class Dopri5RunCartStepper final : public CartStepper {
   using Dopri5 = boost::numeric::odeint::runge_kutta_dopri5<Joint>;
   using Checker =
       dopri5_detail::NotingErrorChecker<double, typename Dopri5::algebra_type, typename Dopri5::operations_type>;
-  using Controlled = boost::numeric::odeint::controlled_runge_kutta<Dopri5, Checker>;
+  using Controlled = DeterministicControlled<Dopri5, Checker>;
   using Dense = boost::numeric::odeint::dense_output_runge_kutta<Controlled>;
 
  public:

@@ -1,5 +1,6 @@
 // Rolling resistance of the four wheels, docs/derivation.md eq. (4.3).
 #include "birkhoff_cart/core/effects/rolling_resistance.h"
+#include "birkhoff_cart/core/deterministic_math.h"
 
 #include <cmath>
 
@@ -26,8 +27,8 @@ void RollingResistance::add_to(const EffectInput& input, GeneralizedForce& total
   std::array<double, 4> d2;
   model_.rim_speed_coefficients(chi, d1, d2);  // r_i φ̇_i = d1_i ω1 + d2_i ω2   (eq. (2.4))
   // ∂d1_i/∂χ (d2 is constant).
-  const double s = std::sin(chi);
-  const double c = std::cos(chi);
+  const double s = deterministic::sin(chi);
+  const double c = deterministic::cos(chi);
   const CartParameters& p = model_.parameters();
   const double a_over_l = p.rear_half_track / p.wheelbase;
   const double cf_over_l = p.front_half_track / p.wheelbase;
@@ -36,7 +37,7 @@ void RollingResistance::add_to(const EffectInput& input, GeneralizedForce& total
   for (int wheel = 0; wheel < 4; ++wheel) {
     const double rim_speed = d1[wheel] * w1 + d2[wheel] * w2;  // v_i [m/s]
     const double ratio = rim_speed / speed_epsilon_;          // [-]
-    const double tanh_ratio = std::tanh(ratio);
+    const double tanh_ratio = deterministic::tanh(ratio);
     const double sech2_ratio = 1.0 - tanh_ratio * tanh_ratio;
     const double load = coefficient_ * normal_load_[wheel];  // c_rr N_i [N]
     // Rim force F_i = τ_i / r_i = −c_rr N_i tanh(v_i/v_eps);  Q_σ += F_i d_σi   (eq. (4.3)).

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "birkhoff_cart/core/effects/torque_source.h"
+#include "birkhoff_cart/core/deterministic_math.h"
 #include "birkhoff_cart/core/torque_profile.h"
 
 namespace birkhoff_cart {
@@ -16,7 +17,7 @@ double TorqueProfile::at(double time) const {
       return value;
     case Kind::kCosine:
       // τ(t) = A cos(2π f t + φ)
-      return amplitude * std::cos(2.0 * M_PI * frequency * time + phase);
+      return amplitude * deterministic::cos(2.0 * M_PI * frequency * time + phase);
     case Kind::kStep:
       return time < step_time ? initial : final;
     case Kind::kRamp: {
@@ -27,7 +28,7 @@ double TorqueProfile::at(double time) const {
     }
     case Kind::kSmoothSwitchOff:
       // τ(t) = τ0 · ½ (1 − tanh((t − t_off)/w))
-      return initial * 0.5 * (1.0 - std::tanh((time - switch_off_time) / width));
+      return initial * 0.5 * (1.0 - deterministic::tanh((time - switch_off_time) / width));
   }
   return 0.0;
 }

@@ -22,6 +22,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "birkhoff_cart/core/deterministic_math.h"
 #include "birkhoff_cart/core/integrators/gauss_collocation.h"
 
 namespace birkhoff_cart {
@@ -53,7 +54,7 @@ constexpr double kLargestLoosenedAim = 5e-5;
 /// τ_a of (B.53) [1/s] for the error per unit step τ [1/s] (> 0).
 template <class Proportionality>
 double aimed_error_per_unit_step(double error_per_unit_step) {
-  const double loosened = std::min({Proportionality::kScale * std::pow(error_per_unit_step, Proportionality::kExponent),
+  const double loosened = std::min({Proportionality::kScale * deterministic::pow(error_per_unit_step, Proportionality::kExponent),
                                     Proportionality::kCap * error_per_unit_step, kLargestLoosenedAim});
   return std::max(error_per_unit_step, loosened);
 }

@@ -1,6 +1,7 @@
 // Wheel odometry of the cart: readings, dead reckoning and covariance (see odometry_sensor.h and
 // docs/odometry_sensor.md for eqs. (O1)–(O7)).
 #include "birkhoff_cart/core/sensors/odometry_sensor.h"
+#include "birkhoff_cart/core/deterministic_math.h"
 
 #include <cmath>
 #include <cstdio>
@@ -78,10 +79,10 @@ double OdometrySensor::standard_normal() {
   constexpr double kUnit = 1.0 / 9007199254740992.0;  // 2^-53
   const double u1 = (static_cast<double>(noise_stream_() >> 11) + 1.0) * kUnit;
   const double u2 = static_cast<double>(noise_stream_() >> 11) * kUnit;
-  const double radius = std::sqrt(-2.0 * std::log(u1));
-  spare_normal_ = radius * std::sin(kTwoPi * u2);
+  const double radius = std::sqrt(-2.0 * deterministic::log(u1));
+  spare_normal_ = radius * deterministic::sin(kTwoPi * u2);
   has_spare_normal_ = true;
-  return radius * std::cos(kTwoPi * u2);
+  return radius * deterministic::cos(kTwoPi * u2);
 }
 
 double OdometrySensor::read_steering(double steering_angle) {
@@ -103,8 +104,8 @@ void OdometrySensor::start(const CartState& state, bool reseed) {
   estimate_ = OdometryEstimate{};
   estimate_.time = state.time;
   // A = B − l (cos θ, sin θ): the estimate starts at the true pose.
-  estimate_.x = state.x - wheelbase_ * std::cos(state.heading);
-  estimate_.y = state.y - wheelbase_ * std::sin(state.heading);
+  estimate_.x = state.x - wheelbase_ * deterministic::cos(state.heading);
+  estimate_.y = state.y - wheelbase_ * deterministic::sin(state.heading);
   estimate_.heading = state.heading;
   covariance_.setZero();
   if (settings_.heading_source == HeadingSource::kSteering) covariance_(3, 3) = steering_reading_variance_;
@@ -154,7 +155,7 @@ const OdometryEstimate& OdometrySensor::read(const CartState& state) {
       heading_sensitivity << -0.5 / rear_half_track_, 0.5 / rear_half_track_, 0.0, 0.0;
       break;
     case HeadingSource::kSteering: {
-      const double tangent = std::tan(0.5 * (previous_steering_reading + steering_reading_));  // tan χ̄
+      const double tangent = deterministic::tan(0.5 * (previous_steering_reading + steering_reading_));  // tan χ̄
       heading_increment = forward * tangent / wheelbase_;
       const double per_reading = forward * (1.0 + tangent * tangent) / (2.0 * wheelbase_);  // ∂Δθ̂/∂χ̂_k
       heading_sensitivity << tangent / (2.0 * wheelbase_), tangent / (2.0 * wheelbase_), per_reading, per_reading;
@@ -174,8 +175,8 @@ const OdometryEstimate& OdometrySensor::read(const CartState& state) {
   double chord_factor = 1.0;                           // sin u / u [-]
   double chord_factor_slope = 0.0;                     // d(sin u / u)/dΔθ̂ [1/rad]
   if (std::abs(half_turn) > 1e-4) {
-    chord_factor = std::sin(half_turn) / half_turn;
-    chord_factor_slope = 0.5 * (std::cos(half_turn) - chord_factor) / half_turn;
+    chord_factor = deterministic::sin(half_turn) / half_turn;
+    chord_factor_slope = 0.5 * (deterministic::cos(half_turn) - chord_factor) / half_turn;
   } else {  // the series: sin u/u = 1 − u²/6 + u⁴/120, its error below 1e-24
     const double square = half_turn * half_turn;
     chord_factor = 1.0 - square / 6.0 + square * square / 120.0;
@@ -183,8 +184,8 @@ const OdometryEstimate& OdometrySensor::read(const CartState& state) {
   }
   const double chord = forward * chord_factor;  // [m]
   const double mean_heading = estimate_.heading + half_turn;
-  const double cosine = std::cos(mean_heading);
-  const double sine = std::sin(mean_heading);
+  const double cosine = deterministic::cos(mean_heading);
+  const double sine = deterministic::sin(mean_heading);
   estimate_.x += chord * cosine;
   estimate_.y += chord * sine;
   estimate_.heading += heading_increment;

@@ -36,7 +36,7 @@ struct IntegratorEntry {
   CartStepperFactory make_reversible = nullptr;  ///< step_control reversible (docs/birkhoffian.md §11); null: not offered
   CartStepperFactory make_adaptive = nullptr;    ///< step_control adaptive (docs/birkhoffian.md §12); null: not offered
   /// Evaluates the s stages' right-hand sides of an iteration together, with one vector sin/cos on
-  /// CPUs with AVX2 (vector_math.h; docs/integrators.md, "Stage evaluation").
+  /// CPUs with AVX (vector_math.h; docs/integrators.md, "Stage evaluation").
   bool vector_stages = false;
 
   /// Takes step_control reversible (the symmetric Birkhoffian members).

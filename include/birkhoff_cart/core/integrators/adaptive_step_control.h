@@ -34,6 +34,7 @@
 #include <string>
 #include <type_traits>
 
+#include "birkhoff_cart/core/deterministic_math.h"
 #include "birkhoff_cart/core/diagnostics.h"
 #include "birkhoff_cart/core/integrators/step_error.h"
 #include "birkhoff_cart/core/integrators/carried_point.h"
@@ -191,7 +192,7 @@ class AdaptiveStepControl {
       // of the rejection that would follow: h/h₋ · (r₋/r)^{1/k} · r^{-1/k}.
       if (last_error_ratio_ > 0.0 && ratio > 0.0 && last_step_ > 0.0 && !lands) {
         const double predictive = settings_.safety * (h / last_step_) *
-                                  std::pow(last_error_ratio_ / (ratio * ratio), 1.0 / kExponentOrder);
+                                  deterministic::pow(last_error_ratio_ / (ratio * ratio), 1.0 / kExponentOrder);
         factor = std::min(factor, std::max(settings_.max_shrink, predictive));
       }
       // After a rejection (Hairer–Nørsett–Wanner I §II.4): the accepted retry does not grow; and while
@@ -242,13 +243,13 @@ class AdaptiveStepControl {
   static constexpr int kExponentOrder = Stepper::kErrorEstimateOrder - 1;  ///< ê/h ∝ h^{q−1}
 
   double shrink_factor(double ratio) const {
-    return std::max(settings_.max_shrink, settings_.safety * std::pow(ratio, -1.0 / kExponentOrder));
+    return std::max(settings_.max_shrink, settings_.safety * deterministic::pow(ratio, -1.0 / kExponentOrder));
   }
   /// After a start the first guess may be far too small: the steps then grow by up to
   /// start_growth until the first rejection or the first step the control would not grow freely.
   double growth_factor(double ratio) {
     const double cap = ramping_ ? settings_.start_growth : settings_.max_growth;
-    const double wanted = ratio > 0.0 ? settings_.safety * std::pow(ratio, -1.0 / kExponentOrder)
+    const double wanted = ratio > 0.0 ? settings_.safety * deterministic::pow(ratio, -1.0 / kExponentOrder)
                                       : std::numeric_limits<double>::infinity();  // ê = 0: grow at once
     if (wanted < settings_.max_growth) ramping_ = false;
     return std::min(cap, std::max(settings_.max_shrink, wanted));

@@ -49,6 +49,7 @@
 #include "birkhoff_cart/core/birkhoffian_system.h"
 #include "birkhoff_cart/core/diagnostics.h"
 #include "birkhoff_cart/core/integrators/step_error.h"
+#include "birkhoff_cart/core/integrators/odeint_step_adjuster.h"
 
 namespace birkhoff_cart {
 
@@ -185,7 +186,7 @@ class DormandPrince5 {
     using Dopri5 = odeint::runge_kutta_dopri5<Joint>;
     using Checker = dopri5_detail::NotingErrorChecker<double, typename Dopri5::algebra_type,
                                                       typename Dopri5::operations_type>;
-    odeint::controlled_runge_kutta<Dopri5, Checker> controlled(Checker(tolerance_, tolerance_, &trial_estimate));
+    DeterministicControlled<Dopri5, Checker> controlled(Checker(tolerance_, tolerance_, &trial_estimate));
     // First internal step: the carried guess (a magnitude), with the sign of h (h < 0 runs backwards).
     const double first_guess = step_size_guess_ > 0.0 ? std::copysign(step_size_guess_, h) : h;
     try {

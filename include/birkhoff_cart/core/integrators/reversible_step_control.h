@@ -34,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include "birkhoff_cart/core/deterministic_math.h"
 #include "birkhoff_cart/core/diagnostics.h"
 #include "birkhoff_cart/core/integrators/step_error.h"
 #include "birkhoff_cart/core/integrators/carried_point.h"
@@ -258,7 +259,7 @@ class ReversibleToleranceControl {
       found.trial_error_ratio = ratio;
       found.trial_span = span;
       found.overestimate = overestimate;
-      const double wanted = ratio > 0.0 ? epsilon * std::pow(0.5 / ratio, 1.0 / kExponent) : kMaxFictiveStep;
+      const double wanted = ratio > 0.0 ? epsilon * deterministic::pow(0.5 / ratio, 1.0 / kExponent) : kMaxFictiveStep;
       const double next = std::min(wanted, kMaxFictiveStep);
       found.fictive_step = next;
       if (next <= 1.5 * epsilon && next >= epsilon / 1.5) break;
@@ -318,14 +319,14 @@ class ReversibleToleranceControl {
     const double h = control_->time() - control_->previous_time();
     const double overestimate =
         calibration_->overestimate *
-        std::pow(calibration_->fictive_step / calibration_->trial_fictive_step, kOverestimateOrder);
+        deterministic::pow(calibration_->fictive_step / calibration_->trial_fictive_step, kOverestimateOrder);
     return statistics.local_error_estimate_last_step / std::max(overestimate, 1.0) / (h * error_per_unit_step_);
   }
 
   /// After a step beyond the calibration: back to the grid point before it, and on from there with
   /// the fictive step the step's own error asks for, ε (½/r)^{1/p} — a new grid.
   void restart_finer(StepStatistics& statistics) {
-    calibration_->fictive_step *= std::pow(0.5 / error_ratio(statistics), 1.0 / Stepper::kOrder);
+    calibration_->fictive_step *= deterministic::pow(0.5 / error_ratio(statistics), 1.0 / Stepper::kOrder);
     if (!(calibration_->fictive_step >= kMinFictiveStep)) {
       throw StepError("the fictive step needed past t = " + std::to_string(control_->previous_time()) +
                       " s fell below " + std::to_string(kMinFictiveStep) + " rad: a looser tolerance");
@@ -357,7 +358,7 @@ class ReversibleToleranceControl {
     unreduce_angles<System>(whole, grid.turns, start.turns);
     const StateVector<Transformed, double> z_error = (whole.z + whole.z_remainder) - (halves.z + halves.z_remainder);
     const PassiveVector<Transformed, double> y_error = (whole.y + whole.y_remainder) - (halves.y + halves.y_remainder);
-    const double doubling = std::pow(2.0, Stepper::kOrder);
+    const double doubling = deterministic::pow(2.0, Stepper::kOrder);
     return local_error_norm<Transformed, double>(whole.z, whole.y, z_error, y_error) * doubling / (doubling - 1.0);
   }
 
