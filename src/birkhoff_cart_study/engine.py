@@ -47,8 +47,9 @@ class RowWriter:
     """Appends one JSON row per line; each row is written whole, flushed and synced, so a row is
     complete or absent whatever interrupts the study."""
 
-    def __init__(self, path):
+    def __init__(self, path, build=None):
         self.path = path
+        self.build = build  # the source commit that measures the rows (report.source_commit), stamped on each
         # Cut a torn last line left by an interrupted write, so appended rows start on a line.
         if os.path.exists(path):
             with open(path, "rb+") as f:
@@ -58,6 +59,8 @@ class RowWriter:
         self.file = open(path, "a")
 
     def write(self, row):
+        if self.build is not None and "build" not in row:
+            row = dict(row, build=self.build)
         self.file.write(json.dumps(row, sort_keys=True) + "\n")
         self.file.flush()
         os.fsync(self.file.fileno())
@@ -184,7 +187,8 @@ def run_study(study, tasks, output_dir, bin_dir, scheduler=None, workers=None, s
     handlers = {number: signal.signal(number, lambda n, frame: stop.append(n)) for number in STOP_SIGNALS}
     new_rows = []
     client = cluster = None
-    writer = RowWriter(rows_path)
+    from .report import source_commit
+    writer = RowWriter(rows_path, build=source_commit())
     try:
         client, cluster = make_client(scheduler, workers, security, connect_timeout)
         threads = sum(w.get("nthreads", 1) for w in client.scheduler_info()["workers"].values())

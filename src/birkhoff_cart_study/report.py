@@ -47,6 +47,25 @@ def source_commit(directory=None):
                      if changed else "")
 
 
+def other_builds(rows):
+    """Which experiments' rows another source commit measured (each row carries the commit that
+    measured it, `build`; rows written before rows carried one say nothing): "none", or each such
+    experiment with its rows' commits. Rows measured before the right-hand sides took their
+    elementary functions from SLEEF (CHANGELOG 0.6.0) reproduce on their own CPU only
+    (docs/developing.md, "Figures that hold on every machine")."""
+    here = source_commit()
+    others = {}
+    for row in rows:
+        build = row.get("build", "an earlier build that recorded none")
+        if build != here:
+            others.setdefault(row.get("label", "?"), set()).add(build)
+    if not others:
+        return "none"
+    return "; ".join("%s: %s (rows measured with glibc's libm reproduce on their own CPU only)"
+                     % (label, ", ".join(sorted(builds))) if builds == {"an earlier build that recorded none"}
+                     else "%s: %s" % (label, ", ".join(sorted(builds))) for label, builds in sorted(others.items()))
+
+
 def stage_evaluation():
     """How the Birkhoffian collocation members evaluate their stages in the runs of this machine
     (docs/integrators.md, "Stage evaluation"): BIRKHOFF_CART_STAGE_EVALUATION when set, else
@@ -89,6 +108,7 @@ def write_report(study, rows, page_path, command, summary):
            "| source commit | %s |" % source_commit(),
            "| machine | %s |" % _cell(machine()),
            "| stage evaluation | %s |" % stage_evaluation(),
+           "| rows of other builds | %s |" % _cell(other_builds(rows)),
            "| Dask workers | %s |" % ", ".join(str(w) for w in workers),
            "| load average while running (1 min, over the tasks) | %s |" % (
                "%.1f–%.1f (median %.1f)" % (loads[0], loads[-1], loads[len(loads) // 2]) if loads else "—"),
