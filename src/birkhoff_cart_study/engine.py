@@ -59,8 +59,8 @@ class RowWriter:
         self.file = open(path, "a")
 
     def write(self, row):
-        if self.build is not None and "build" not in row:
-            row = dict(row, build=self.build)
+        if self.build is not None:
+            row.setdefault("build", self.build)  # in place: the report reads the same row
         self.file.write(json.dumps(row, sort_keys=True) + "\n")
         self.file.flush()
         os.fsync(self.file.fileno())

@@ -48,21 +48,26 @@ def source_commit(directory=None):
 
 
 def other_builds(rows):
-    """Which experiments' rows another source commit measured (each row carries the commit that
-    measured it, `build`; rows written before rows carried one say nothing): "none", or each such
-    experiment with its rows' commits. Rows measured before the right-hand sides took their
+    """Which experiments' rows a build other than most rows' measured (each row carries the source
+    commit that measured it, `build`; rows written before rows carried one say nothing): "none", or
+    each such experiment with its rows' commits. Rows measured before the right-hand sides took their
     elementary functions from SLEEF (CHANGELOG 0.6.0) reproduce on their own CPU only
     (docs/developing.md, "Figures that hold on every machine")."""
-    here = source_commit()
+    unrecorded = "an earlier build that recorded none"
+    counts = {}
+    for row in rows:
+        build = row.get("build", unrecorded)
+        counts[build] = counts.get(build, 0) + 1
+    if len(counts) <= 1:
+        return "none"
+    most = max(counts, key=counts.get)
     others = {}
     for row in rows:
-        build = row.get("build", "an earlier build that recorded none")
-        if build != here:
+        build = row.get("build", unrecorded)
+        if build != most:
             others.setdefault(row.get("label", "?"), set()).add(build)
-    if not others:
-        return "none"
     return "; ".join("%s: %s (rows measured with glibc's libm reproduce on their own CPU only)"
-                     % (label, ", ".join(sorted(builds))) if builds == {"an earlier build that recorded none"}
+                     % (label, ", ".join(sorted(builds))) if builds == {unrecorded}
                      else "%s: %s" % (label, ", ".join(sorted(builds))) for label, builds in sorted(others.items()))
 
 

@@ -152,3 +152,12 @@ def test_no_rows_crash_the_report(text, registry, study_file, tmp_path):
         page = str(tmp_path / "page.md")
         write_report(study, rows, page, "study x", "summary | line")
         assert open(page).read().startswith("# Results: ")
+
+
+def test_the_page_names_the_experiments_whose_rows_another_build_measured():
+    from birkhoff_cart_study.report import other_builds
+    now = [{"label": "a", "build": "`new`"}, {"label": "b", "build": "`new`"}, {"label": "b", "build": "`new`"}]
+    assert other_builds(now) == "none"
+    assert other_builds(now + [{"label": "c"}]) == \
+        "c: an earlier build that recorded none (rows measured with glibc's libm reproduce on their own CPU only)"
+    assert other_builds(now + [{"label": "a", "build": "`old`"}]) == "a: `old`"
