@@ -438,8 +438,13 @@ def run_block(block, scratch, environment, display):
                ROS_HOME=str(scratch / "ros_home"), BIRKHOFF_CART_WORKSPACE=str(scratch / ".ws"),
                MPLBACKEND="Agg", DOC_COMMANDS_BLOCK=token, PYTHONUNBUFFERED="1")
     env.pop("DISPLAY", None)
-    if display and USES_DISPLAY.search(block.text):
-        env["DISPLAY"] = display
+    env.pop("XAUTHORITY", None)  # the caller's cookie file belongs to another server
+    uses_display = display is not None and bool(USES_DISPLAY.search(block.text))
+    if uses_display:
+        name = display.acquire()
+        if name is None:
+            return Outcome(block, "failed", "no virtual display: Xvfb did not start (scripts/setup.sh installs xvfb)", 0.0)
+        env["DISPLAY"] = name
     terminals, master, log = [], None, []
     try:
         if USES_ROS.search(block.text):
@@ -485,6 +490,8 @@ def run_block(block, scratch, environment, display):
         for terminal in terminals:
             problem = terminal_problem(terminal)
             if problem:
+                if uses_display:
+                    problem += display_diagnosis(display, env)
                 return Outcome(block, "failed", problem, time.monotonic() - started)
         return Outcome(block, "passed", "", time.monotonic() - started)
     finally:
@@ -562,6 +569,18 @@ def finish(block, started, status, output):
     return Outcome(block, "passed", "", time.monotonic() - started)
 
 
+def display_diagnosis(display, env):
+    """What a failed rviz block's reader needs: whether the display is still up, and the end of
+    each rviz log roslaunch wrote under ROS_HOME (rviz's own messages: a crash, a lost display)."""
+    name = env.get("DISPLAY", "")
+    lines = [f"\nthe display {name}: " + ("accepts connections" if name and display_accepts(name[1:])
+                                          else "does NOT accept connections")]
+    lines += [f"\n{lost}" for lost in display.lost]
+    for log in sorted(pathlib.Path(env.get("ROS_HOME", "/nonexistent"), "log").glob("**/rviz*.log")):
+        lines.append(f"\n{log.name}:\n" + tail(log.read_text(errors="replace"), 15))
+    return "".join(lines)
+
+
 def tail(text, lines=25):
     kept = (text or "").rstrip().split("\n")[-lines:]
     return "\n".join("    " + line for line in kept)
@@ -587,22 +606,93 @@ def marker_problem(block, root):
     return f"{block.where}: the marker names no existing test or file in backticks as what CI runs instead"
 
 
-def start_display():
-    """A virtual X display for rviz (Xvfb, -displayfd picks a free number); (process, ':N')."""
+def start_display(log_path=os.devnull):
+    """A virtual X display for rviz (Xvfb, -displayfd picks a free number; -noreset: the server
+    keeps its state when its last client leaves, so that the next rviz never meets a server in
+    the middle of a reset); (process, ':N') once it accepts a connection, else (None, None). Its
+    own messages go to log_path."""
     if not shutil.which("Xvfb"):
         return None, None
     read_end, write_end = os.pipe()
-    process = subprocess.Popen(["Xvfb", "-displayfd", str(write_end), "-screen", "0", "1024x768x24", "-nolisten", "tcp"],
-                               pass_fds=(write_end,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                               start_new_session=True)
+    with open(log_path, "ab") as log:
+        process = subprocess.Popen(["Xvfb", "-displayfd", str(write_end), "-screen", "0", "1024x768x24", "-nolisten",
+                                    "tcp", "-noreset"], pass_fds=(write_end,), stdout=log, stderr=log,
+                                   start_new_session=True)
     os.close(write_end)
-    ready, _, _ = select.select([read_end], [], [], 20)
-    number = os.read(read_end, 64).decode().strip() if ready else ""
+    # Xvfb writes the number, then a newline, then closes its end; closing ours after the number
+    # alone made its second write fail, and Xvfb exits at once ("Cannot write display number to
+    # fd"): every rviz block then met "could not connect to display". Read up to the newline.
+    written = b""
+    waited_until = time.monotonic() + 20
+    while b"\n" not in written and time.monotonic() < waited_until:
+        ready, _, _ = select.select([read_end], [], [], max(0.0, waited_until - time.monotonic()))
+        chunk = os.read(read_end, 64) if ready else b""
+        if not chunk:
+            break
+        written += chunk
     os.close(read_end)
-    if not number:
+    number = written.decode().strip()
+    # And then until the server completes a connection setup.
+    while number and not display_accepts(number) and time.monotonic() < waited_until and process.poll() is None:
+        time.sleep(0.1)
+    if not number or not display_accepts(number):
         process.kill()
+        process.wait()
         return None, None
     return process, f":{number}"
+
+
+def display_accepts(number):
+    """Does X display :number complete an X11 connection setup on its socket
+    (/tmp/.X11-unix/X<number>; no authorization, as the doc test's Xvfb needs none)?"""
+    with socket.socket(socket.AF_UNIX) as connection:
+        connection.settimeout(5)
+        try:
+            connection.connect(f"/tmp/.X11-unix/X{number}")
+            # Setup request: byte order 'l', protocol 11.0, no authorization name or data.
+            connection.sendall(b"l\0" + (11).to_bytes(2, "little") + bytes(8))
+            return connection.recv(1) == b"\1"  # 1: Success (0: Failed, 2: Authenticate)
+        except OSError:
+            return False
+
+
+class Display:
+    """The doc test's virtual display, shared by the pages' threads: started when a block first
+    needs it, and started again (its death named in the block's outcome) when it no longer
+    accepts connections, so that one lost server does not fail every later rviz block."""
+
+    def __init__(self, log_path):
+        self.log_path = log_path
+        self.process = None
+        self.name = None
+        self.lock = threading.Lock()
+        self.lost = []
+
+    def acquire(self):
+        """':N' of a display that accepts connections now, or None without Xvfb."""
+        with self.lock:
+            if self.process is not None and (self.process.poll() is not None
+                                             or not display_accepts(self.name[1:])):
+                self.lost.append(f"the doc test's Xvfb on {self.name} was lost (exit status "
+                                 f"{self.process.poll()}); started another")
+                self.stop_locked()
+            if self.process is None:
+                self.process, self.name = start_display(self.log_path)
+            return self.name
+
+    def stop_locked(self):
+        if self.process is not None:
+            self.process.terminate()
+            try:
+                self.process.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait()
+        self.process, self.name = None, None
+
+    def stop(self):
+        with self.lock:
+            self.stop_locked()
 
 
 def run_pages(pages, root=REPO, devel=None, jobs=2, only=None, keep=False, progress=print):
@@ -630,7 +720,7 @@ def run_pages(pages, root=REPO, devel=None, jobs=2, only=None, keep=False, progr
     files = tracked_files(root)
     environment = devel_environment(devel)
     scratch_parent = pathlib.Path(tempfile.mkdtemp(prefix="doc_commands_"))
-    display_process, display = (start_display() if any(USES_DISPLAY.search(b.text) for b in to_run) else (None, None))
+    display = Display(scratch_parent / "xvfb.log") if any(USES_DISPLAY.search(b.text) for b in to_run) else None
     by_page = {}
     for block in to_run:
         by_page.setdefault(block.page, []).append(block)
@@ -643,9 +733,8 @@ def run_pages(pages, root=REPO, devel=None, jobs=2, only=None, keep=False, progr
             for future in concurrent.futures.as_completed(futures):
                 outcomes.extend(future.result())
     finally:
-        if display_process is not None:
-            display_process.terminate()
-            display_process.wait()
+        if display is not None:
+            display.stop()
         if not keep:
             shutil.rmtree(scratch_parent, ignore_errors=True)
     order = {id(block): index for index, block in enumerate(blocks)}
