@@ -53,7 +53,7 @@ MUTATIONS = [
     Mutation(
         "nonholonomic_force_sign",
         "the nonholonomic force Λ_nh,1 in ṗ1 = Λ_nh,1 + Q1 enters with the wrong sign",
-        "include/birkhoff_cart/core/cart_model.h",
+        "include/birkhoff_cart/core/physics/cart_model.h",
         "rate(0) = nonholonomic_force_at(s, c, quasi_velocity)(0) + generalized_force(0);",
         "rate(0) = -nonholonomic_force_at(s, c, quasi_velocity)(0) + generalized_force(0);",
         [(TRAJECTORY, "*"), ("cart_birkhoffian_test", "*")],
@@ -77,7 +77,7 @@ MUTATIONS = [
     Mutation(
         "dropped_air_drag_force",
         "an effect term is dropped: air drag adds its Jacobian but no force",
-        "src/core/effects/air_drag.cpp",
+        "src/core/physics/effects/air_drag.cpp",
         "total.force(0) += -k * std::abs(speed_a) * speed_a * c;",
         "static_cast<void>(c);",
         [(TRAJECTORY, "*"), ("effects_test", "*"), ("independent_model_test", "*")],
@@ -95,7 +95,7 @@ MUTATIONS = [
     Mutation(
         "nan_drive_torque_accepted",
         "a NaN drive_torque command is accepted",
-        "src/core/simulation.cpp",
+        "src/core/run/simulation.cpp",
         'require_finite_torque(torque, "drive");',
         "",
         [("bad_input_test", "*"), ("simulation_test", "*")],
@@ -129,7 +129,7 @@ MUTATIONS = [
     Mutation(
         "angle_reduction_turns",
         "the angle reduction loses the whole turns it removes",
-        "include/birkhoff_cart/core/angle_reduction.h",
+        "include/birkhoff_cart/core/integrators/angle_reduction.h",
         "  remainder -= k * kTwoPiLow;\n  turns += k;",
         "  remainder -= k * kTwoPiLow;\n  turns += 0.0 * k;",
         [("gauss_collocation_test", "*"), ("long_run_test", "*")],
@@ -171,7 +171,7 @@ MUTATIONS = [
     Mutation(
         "accuracy_guard_comparison",
         "the accuracy guard compares with the warning limit where the error limit belongs",
-        "src/core/accuracy_guard.cpp",
+        "src/core/scene/accuracy_guard.cpp",
         "if (value > limit.error) note(quantity, AccuracyLevel::kError, limit.error);",
         "if (value > limit.warn) note(quantity, AccuracyLevel::kError, limit.error);",
         [("accuracy_guard_test", "*")],
@@ -179,9 +179,9 @@ MUTATIONS = [
     Mutation(
         "effect_coefficient_range",
         "the effect table lets rolling resistance's speed_epsilon be 0 (tanh(v/0): NaN forces from rest)",
-        "src/core/effects/effect_library.cpp",
-        '{"speed_epsilon", Range::kPositive, "m/s", 0.05}',
-        '{"speed_epsilon", Range::kNonNegative, "m/s", 0.05}',
+        "src/core/physics/effects/effect_library.cpp",
+        '{"speed_epsilon", Range::kPositive, "m/s", 0.05, 0.01, 0.2}',
+        '{"speed_epsilon", Range::kNonNegative, "m/s", 0.05, 0.01, 0.2}',
         [("scene_test", "*")],
     ),
     Mutation(
@@ -203,7 +203,7 @@ MUTATIONS = [
     Mutation(
         "restart_speed_unchecked",
         "a teleport's forward speed is not checked against what one step resolves (1e200 m/s accepted)",
-        "src/core/restart_state.cpp",
+        "src/core/physics/restart_state.cpp",
         "require_within(\"forward_speed\", s.forward_speed, kLargestStepFraction * wheelbase / step_size, \"m/s\",",
         "require_within(\"forward_speed\", s.forward_speed, 1e300 * wheelbase / step_size, \"m/s\",",
         [("restart_test", "*")],
@@ -211,7 +211,7 @@ MUTATIONS = [
     Mutation(
         "restart_without_trial_step",
         "a teleport is committed without its trial step (a state whose first step fails is accepted)",
-        "src/core/simulation.cpp",
+        "src/core/run/simulation.cpp",
         "  check_trial_step(restarted);\n",
         "",
         [("restart_test", "*")],

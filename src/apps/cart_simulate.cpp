@@ -47,19 +47,19 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/accuracy_guard.h"
-#include "birkhoff_cart/core/closest_name.h"
+#include "birkhoff_cart/core/scene/accuracy_guard.h"
+#include "birkhoff_cart/core/support/closest_name.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/cart_binding/integrator_registry.h"
-#include "birkhoff_cart/core/guarded_run.h"
-#include "birkhoff_cart/core/paper_form_drift.h"
-#include "birkhoff_cart/core/run_summary.h"
-#include "birkhoff_cart/core/random_scene.h"
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/sensors/odometry_sensor.h"
-#include "birkhoff_cart/core/simulation.h"
-#include "birkhoff_cart/core/step_schedule.h"
-#include "birkhoff_cart/core/version.h"
+#include "birkhoff_cart/core/run/guarded_run.h"
+#include "birkhoff_cart/core/run/paper_form_drift.h"
+#include "birkhoff_cart/core/run/run_summary.h"
+#include "birkhoff_cart/core/run/random_scene.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/physics/sensors/odometry_sensor.h"
+#include "birkhoff_cart/core/run/simulation.h"
+#include "birkhoff_cart/core/scene/step_schedule.h"
+#include "birkhoff_cart/core/support/version.h"
 
 namespace {
 
@@ -502,7 +502,7 @@ int run(int argc, char** argv) {
   if (guard.level() == birkhoff_cart::AccuracyLevel::kError) {
     const bool warn_only = arguments.count("--on-accuracy-error") && arguments.at("--on-accuracy-error") == "warn";
     std::fprintf(stderr, "cart_simulate: accuracy %s%s%s\n", guard.summary().c_str(),
-                 birkhoff_cart::accuracy_binding_note(*simulation, guard).c_str(),
+                 birkhoff_cart::accuracy_binding_note(simulation, guard).c_str(),
                  warn_only ? " (--on-accuracy-error warn: exit 0)" : "");
     if (!warn_only) return kExitAccuracy;
   }

@@ -25,12 +25,12 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/cart_model.h"
-#include "birkhoff_cart/core/effect_library.h"
-#include "birkhoff_cart/core/effects.h"
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/simulation.h"
-#include "birkhoff_cart/core/version.h"
+#include "birkhoff_cart/core/physics/cart_model.h"
+#include "birkhoff_cart/core/physics/effect_library.h"
+#include "birkhoff_cart/core/physics/effects.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/run/simulation.h"
+#include "birkhoff_cart/core/support/version.h"
 
 namespace {
 

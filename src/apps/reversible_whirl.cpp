@@ -24,9 +24,9 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/simulation.h"
-#include "birkhoff_cart/core/version.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/run/simulation.h"
+#include "birkhoff_cart/core/support/version.h"
 
 namespace {
 

@@ -19,7 +19,7 @@
 #include <exception>
 #include <string>
 
-#include "birkhoff_cart/core/version.h"
+#include "birkhoff_cart/core/support/version.h"
 #include "work_precision/price.h"
 #include "work_precision/single_task.h"
 

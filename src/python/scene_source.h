@@ -7,7 +7,7 @@
 
 #include <string>
 
-#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/scene/scene.h"
 
 namespace birkhoff_cart {
 namespace python {

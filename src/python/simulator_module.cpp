@@ -17,13 +17,13 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/accuracy_guard.h"
+#include "birkhoff_cart/core/scene/accuracy_guard.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/cart_binding/integrator_registry.h"
-#include "birkhoff_cart/core/run_summary.h"
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/version.h"
-#include "birkhoff_cart/core/guarded_run.h"
+#include "birkhoff_cart/core/run/run_summary.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/support/version.h"
+#include "birkhoff_cart/core/run/guarded_run.h"
 #include "scene_source.h"
 
 namespace py = pybind11;

@@ -8,7 +8,7 @@
 
 #include <diagnostic_msgs/DiagnosticStatus.h>
 
-#include "birkhoff_cart/core/run_summary.h"
+#include "birkhoff_cart/core/run/run_summary.h"
 #include "birkhoff_cart/ros/parameter_reading.h"
 
 namespace birkhoff_cart {

@@ -10,7 +10,7 @@
 #include <cmath>
 #include <limits>
 
-#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/scene/scene.h"
 #include "birkhoff_cart/ros/accuracy_reporting.h"
 #include "birkhoff_cart/ros/parameter_reading.h"
 

@@ -12,8 +12,8 @@
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 
-#include "birkhoff_cart/core/accuracy_floors.h"
-#include "birkhoff_cart/core/run_summary.h"
+#include "birkhoff_cart/core/run/accuracy_floors.h"
+#include "birkhoff_cart/core/run/run_summary.h"
 #include "birkhoff_cart/ros/accuracy_reporting.h"
 
 namespace birkhoff_cart {
@@ -177,7 +177,7 @@ void CartSimReports::write_summary(const std::string& outcome) {
        << " N m s, max constraint residual = " << diagnostics.max_constraint_residual << " m/s";
   if (diagnostics.has_reference) {
     text << ", reference position error = " << diagnostics.reference_position_error << " m";
-    // A reference judges only errors ≥ 10× its own (docs/accuracy.md §4.3).
+    // A reference judges only errors ≥ 10× its own (docs/accuracy.md §4.4).
     const double resolution = shadow_reference_resolution(run_.simulation.scene());  // [m]; 0: not estimated
     if (resolution > 0.0 && !(diagnostics.reference_position_error >= 10.0 * resolution)) {
       text << " (not resolved: the shadow reference is itself off by up to ~" << resolution

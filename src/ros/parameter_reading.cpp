@@ -6,7 +6,7 @@
 
 #include <ros/param.h>
 
-#include "birkhoff_cart/core/closest_name.h"
+#include "birkhoff_cart/core/support/closest_name.h"
 
 #include <XmlRpcValue.h>
 

@@ -13,8 +13,8 @@
 #include <tf2/utils.h>
 #include <tf2_ros/transform_listener.h>
 
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "birkhoff_cart/ros/conversions.h"
 #include "test_helpers.h"
 

@@ -7,8 +7,8 @@
 
 #include <tf2/utils.h>
 
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "birkhoff_cart/ros/conversions.h"
 
 namespace birkhoff_cart {

@@ -1,7 +1,8 @@
 // The list of parameters cart_sim reads (cart_sim_parameter_names(), behind its "did you mean"
-// report of a misspelled parameter) is the list load_parameters() reads: every name it passes to a
-// reader appears in the list and every listed name is read, so a parameter added later is not
-// reported as a typo and a parameter removed is no longer accepted in silence. And the parameter
+// report of a misspelled parameter) is the list load_parameters() reads: every row of the parameter
+// table (parameter_rows() in cart_sim_parameters.cpp) reads the name it is listed under and no other,
+// and every listed name is read, so a parameter added later is not reported as a typo and a
+// parameter removed is no longer accepted in silence. And the parameter
 // table of docs/ros_interface.md ("### Parameters (all private)" of cart_sim) holds exactly that list:
 // every `~name` of its first column is a name cart_sim reads, and every name it reads has its row
 // (dynamic_reconfigure's copies of the guard limits as the `<quantity>_warn` / `<quantity>_error`
@@ -16,8 +17,9 @@
 #include <regex>
 #include <set>
 #include <sstream>
-#include <utility>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
 #include "birkhoff_cart/ros/cmd_vel_controller_node.h"
@@ -29,16 +31,29 @@ TEST(CartSimParameterNames, AreExactlyTheNamesLoadParametersReads) {
   std::ifstream file(std::string(BIRKHOFF_CART_SOURCE_DIR) + "/src/ros/cart_sim_parameters.cpp");
   ASSERT_TRUE(file.good());
   const std::string source((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  const auto body_start = source.find("CartSimParameters load_parameters(");
+  const auto body_start = source.find("const std::vector<ParameterRow>& parameter_rows()");
   ASSERT_NE(body_start, std::string::npos);
   const std::string body = source.substr(body_start);
   // read_parameter<T>(p, "name", ...), read_double_parameter(p, "name", ...), read_variances(p, "name", ...)
   const std::regex read(R"(read_[a-z_]+(<[^(]*>)?\(\s*p,\s*\"([a-z_0-9]+)\")");
-  std::set<std::string> read_names;
-  for (auto it = std::sregex_iterator(body.begin(), body.end(), read); it != std::sregex_iterator(); ++it) {
-    read_names.insert((*it)[2]);
+  // A row of the table: {"name", [](Node p, Parameters parameters) {...}}; what it reads runs to the next row.
+  const std::regex row_start(R"(\{\"([a-z_0-9]+)\",\s*\[\]\(Node p, Parameters parameters\))");
+  std::vector<std::pair<std::string, std::size_t>> rows;
+  for (auto it = std::sregex_iterator(body.begin(), body.end(), row_start); it != std::sregex_iterator(); ++it) {
+    rows.emplace_back((*it)[1], static_cast<std::size_t>(it->position()));
   }
-  ASSERT_GE(read_names.size(), 30u) << "the pattern no longer matches the readers";
+  ASSERT_GE(rows.size(), 30u) << "the pattern no longer matches the table's rows";
+  std::set<std::string> read_names;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const std::size_t end = i + 1 < rows.size() ? rows[i + 1].second : body.find("check_together", rows[i].second);
+    const std::string text = body.substr(rows[i].second, end - rows[i].second);
+    std::set<std::string> in_row;
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), read); it != std::sregex_iterator(); ++it) {
+      in_row.insert((*it)[2]);
+    }
+    EXPECT_EQ(in_row, std::set<std::string>{rows[i].first}) << "the row of ~" << rows[i].first << " reads other names";
+    read_names.insert(in_row.begin(), in_row.end());
+  }
   std::set<std::string> listed(cart_sim_parameter_names().begin(), cart_sim_parameter_names().end());
   // Read elsewhere: ~end_launch (nodes/cart_sim.cpp); ~accuracy/... and the residual thresholds
   // (accuracy_reporting.cpp); dynamic_reconfigure's own copies (cfg/CartSim.cfg). Each must occur,

@@ -18,9 +18,9 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/accuracy_guard.h"
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/scene/accuracy_guard.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "generated_docs.h"
 #include "test_scenes.h"
 

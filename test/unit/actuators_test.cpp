@@ -12,12 +12,12 @@
 #include <memory>
 #include <string>
 
-#include "birkhoff_cart/core/actuators/steering_end_stops.h"
-#include "birkhoff_cart/core/actuators/torque_actuator.h"
-#include "birkhoff_cart/core/cart_model.h"
-#include "birkhoff_cart/core/run_summary.h"
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/physics/actuators/steering_end_stops.h"
+#include "birkhoff_cart/core/physics/actuators/torque_actuator.h"
+#include "birkhoff_cart/core/physics/cart_model.h"
+#include "birkhoff_cart/core/run/run_summary.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "generated_docs.h"
 
 namespace birkhoff_cart {

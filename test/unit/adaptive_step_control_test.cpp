@@ -16,13 +16,13 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/cart_birkhoffian.h"
-#include "birkhoff_cart/core/effect_library.h"
+#include "birkhoff_cart/core/physics/cart_birkhoffian.h"
+#include "birkhoff_cart/core/physics/effect_library.h"
 #include "birkhoff_cart/core/integrators/adaptive_step_control.h"
 #include "birkhoff_cart/core/cart_binding/carried_state.h"
 #include "birkhoff_cart/core/integrators/gauss_collocation.h"
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "test_scenes.h"
 
 namespace birkhoff_cart {

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/effect_library.h"
-#include "birkhoff_cart/core/effect_spec.h"
+#include "birkhoff_cart/core/physics/effect_library.h"
+#include "birkhoff_cart/core/physics/effect_spec.h"
 
 namespace birkhoff_cart_test {
 

@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/autodiff.h"
-#include "birkhoff_cart/core/birkhoffian_system.h"
-#include "birkhoff_cart/core/cart_birkhoffian.h"
-#include "birkhoff_cart/core/effect_library.h"
+#include "birkhoff_cart/core/integrators/autodiff.h"
+#include "birkhoff_cart/core/integrators/birkhoffian_system.h"
+#include "birkhoff_cart/core/physics/cart_birkhoffian.h"
+#include "birkhoff_cart/core/physics/effect_library.h"
 #include "birkhoff_cart/core/integrators/newton.h"
 #include "structure_checks.h"
 #include "test_systems.h"

@@ -8,11 +8,11 @@
 #include <random>
 #include <vector>
 
-#include "birkhoff_cart/core/birkhoffian_system.h"
+#include "birkhoff_cart/core/integrators/birkhoffian_system.h"
 #include "all_effects.h"
-#include "birkhoff_cart/core/cart_birkhoffian.h"
-#include "birkhoff_cart/core/cart_model.h"
-#include "birkhoff_cart/core/effect_library.h"
+#include "birkhoff_cart/core/physics/cart_birkhoffian.h"
+#include "birkhoff_cart/core/physics/cart_model.h"
+#include "birkhoff_cart/core/physics/effect_library.h"
 #include "birkhoff_cart/core/integrators/birkhoff_symplectic.h"
 #include "full_coordinate_model.h"
 

@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "all_effects.h"
-#include "birkhoff_cart/core/cart_birkhoffian.h"
-#include "birkhoff_cart/core/cart_model.h"
-#include "birkhoff_cart/core/effect_library.h"
+#include "birkhoff_cart/core/physics/cart_birkhoffian.h"
+#include "birkhoff_cart/core/physics/cart_model.h"
+#include "birkhoff_cart/core/physics/effect_library.h"
 #include "birkhoff_cart/core/integrators/newton.h"
 
 namespace birkhoff_cart {

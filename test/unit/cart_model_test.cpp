@@ -10,8 +10,8 @@
 #include <random>
 #include <stdexcept>
 
-#include "birkhoff_cart/core/autodiff.h"
-#include "birkhoff_cart/core/cart_model.h"
+#include "birkhoff_cart/core/integrators/autodiff.h"
+#include "birkhoff_cart/core/physics/cart_model.h"
 #include "full_coordinate_model.h"
 
 namespace birkhoff_cart {

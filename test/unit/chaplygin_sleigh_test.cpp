@@ -14,7 +14,7 @@
 #include <random>
 #include <string>
 
-#include "birkhoff_cart/core/autodiff.h"
+#include "birkhoff_cart/core/integrators/autodiff.h"
 #include "birkhoff_cart/core/examples/chaplygin_sleigh.h"
 #include "birkhoff_cart/core/integrators/gauss_collocation.h"
 #include "generated_docs.h"

@@ -2,7 +2,7 @@
 // to none (the "did you mean" of the nodes' parameter reports).
 #include <gtest/gtest.h>
 
-#include "birkhoff_cart/core/closest_name.h"
+#include "birkhoff_cart/core/support/closest_name.h"
 
 namespace birkhoff_cart {
 namespace {

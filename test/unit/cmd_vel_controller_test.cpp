@@ -10,8 +10,8 @@
 #include <limits>
 #include <stdexcept>
 
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "birkhoff_cart/core/node_logic/cmd_vel_controller.h"
 
 namespace birkhoff_cart {

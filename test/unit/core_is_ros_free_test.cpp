@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/cart_model.h"
+#include "birkhoff_cart/core/physics/cart_model.h"
 
 namespace {
 

@@ -19,10 +19,10 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "birkhoff_cart/core/effect_library.h"
+#include "birkhoff_cart/core/physics/effect_library.h"
 #include "birkhoff_cart/core/cart_binding/integrator_registry.h"
 #include "birkhoff_cart/core/integrators/adaptive_refusal.h"
-#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/scene/scene.h"
 #include "generated_docs.h"
 #include "test_scenes.h"
 
@@ -40,7 +40,7 @@ std::string step_controls(const IntegratorEntry& entry) {
   std::string controls = entry.takes_tolerance() ? "fixed (its own steps inside h, for `tolerance`)" : "fixed";
   if (entry.reversible()) controls += ", reversible";
   if (entry.adaptive()) controls += ", adaptive";
-  if (adaptive_refusal(entry.name) != nullptr) controls += " (adaptive refused: [accuracy.md](accuracy.md) §4.3)";
+  if (adaptive_refusal(entry.name) != nullptr) controls += " (adaptive refused: [accuracy.md](accuracy.md) §4.4)";
   return controls;
 }
 

@@ -7,7 +7,7 @@
 #include <limits>
 #include <string>
 
-#include "birkhoff_cart/core/diagnostics.h"
+#include "birkhoff_cart/core/integrators/diagnostics.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/integrators/dopri5.h"
 #include "test_systems.h"

@@ -10,17 +10,17 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/autodiff.h"
-#include "birkhoff_cart/core/cart_model.h"
-#include "birkhoff_cart/core/effect_library.h"
-#include "birkhoff_cart/core/effects.h"
-#include "birkhoff_cart/core/effects/air_drag.h"
-#include "birkhoff_cart/core/effects/drive_torque.h"
-#include "birkhoff_cart/core/effects/rolling_resistance.h"
-#include "birkhoff_cart/core/effects/steering_damping.h"
-#include "birkhoff_cart/core/effects/steering_stiffness.h"
-#include "birkhoff_cart/core/effects/steering_torque.h"
-#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/integrators/autodiff.h"
+#include "birkhoff_cart/core/physics/cart_model.h"
+#include "birkhoff_cart/core/physics/effect_library.h"
+#include "birkhoff_cart/core/physics/effects.h"
+#include "birkhoff_cart/core/physics/effects/air_drag.h"
+#include "birkhoff_cart/core/physics/effects/drive_torque.h"
+#include "birkhoff_cart/core/physics/effects/rolling_resistance.h"
+#include "birkhoff_cart/core/physics/effects/steering_damping.h"
+#include "birkhoff_cart/core/physics/effects/steering_stiffness.h"
+#include "birkhoff_cart/core/physics/effects/steering_torque.h"
+#include "birkhoff_cart/core/scene/scene.h"
 #include "all_effects.h"
 
 namespace birkhoff_cart {

@@ -27,12 +27,12 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/diagnostics.h"
+#include "birkhoff_cart/core/integrators/diagnostics.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
-#include "birkhoff_cart/core/reference_solution.h"
-#include "birkhoff_cart/core/run_summary.h"
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/run/reference_solution.h"
+#include "birkhoff_cart/core/run/run_summary.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "generated_docs.h"
 
 namespace birkhoff_cart {

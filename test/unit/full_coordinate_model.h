@@ -23,7 +23,7 @@
 #include <cmath>
 #include <unsupported/Eigen/AutoDiff>
 
-#include "birkhoff_cart/core/parameters.h"
+#include "birkhoff_cart/core/physics/parameters.h"
 
 namespace birkhoff_cart {
 namespace full_model {

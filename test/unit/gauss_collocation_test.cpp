@@ -12,13 +12,13 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/angle_reduction.h"
-#include "birkhoff_cart/core/cart_model.h"
-#include "birkhoff_cart/core/effect_library.h"
-#include "birkhoff_cart/core/effects.h"
+#include "birkhoff_cart/core/integrators/angle_reduction.h"
+#include "birkhoff_cart/core/physics/cart_model.h"
+#include "birkhoff_cart/core/physics/effect_library.h"
+#include "birkhoff_cart/core/physics/effects.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/integrators/gauss_legendre_tableau.h"
-#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/scene/scene.h"
 #include "generated_docs.h"
 
 namespace birkhoff_cart {

@@ -20,9 +20,9 @@
 #include <vector>
 
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/simulation.h"
-#include "birkhoff_cart/core/singular_steering.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/run/simulation.h"
+#include "birkhoff_cart/core/physics/singular_steering.h"
 #include "generated_docs.h"
 #include "test_scenes.h"
 
@@ -493,18 +493,13 @@ Scene step_torque_scene() {
   return scene;
 }
 
-/// The measured outcome of the large-step runs, pinned: two compositions at h = 0.2 s stop with a
-/// named error, where a backward sub-step (γh = −0.34 s for birkhoff4, −0.14 s for birkhoff6_kahan_li)
-/// runs through the step torque and its stage solve settles on a spurious root: birkhoff4 in the
-/// paper form at t = 2 s (the step's energy balance breaks; before that check it ran on to a
-/// singular Newton matrix at 2.27 s with T* = 3e78 J), birkhoff6_kahan_li in the autonomous form at
-/// 5.8 s (its stages wander 1e5 rad from their starting values; before that check it handed out
-/// T* = 5e16 J). Every other member, new ones included, runs to the end.
-bool large_step_run_stops(const Method& method, double h) {
-  if (h != 0.2) return false;
-  return (method.integrator == "birkhoff4" && method.form == BirkhoffianForm::kPaper) ||
-         (method.integrator == "birkhoff6_kahan_li" && method.form == BirkhoffianForm::kAutonomous);
-}
+/// The measured outcome of the large-step runs, pinned: every member runs to the end. At h = 0.2 s
+/// two compositions' backward sub-steps (γh = −0.34 s for birkhoff4, −0.14 s for birkhoff6_kahan_li)
+/// run through the step torque and their stage solves settle on a spurious root (birkhoff4 in the
+/// paper form at t = 2 s: the energy balance breaks; birkhoff6_kahan_li in the autonomous form at
+/// 5.8 s: its stages wander 1e5 rad); those steps are taken again in substeps (cart_stepper_adapter.h)
+/// and the runs end bounded. A run that stops must stop with a one-line error and its state kept.
+bool large_step_run_stops(const Method&, double) { return false; }
 
 TEST(LargeSteps, BoundedOrAClearErrorNeverGarbage) {
   Scene fine = step_torque_scene();

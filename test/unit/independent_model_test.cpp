@@ -12,13 +12,13 @@
 #include <memory>
 #include <random>
 
-#include "birkhoff_cart/core/autodiff.h"
-#include "birkhoff_cart/core/cart_model.h"
-#include "birkhoff_cart/core/effects.h"
-#include "birkhoff_cart/core/effects/air_drag.h"
-#include "birkhoff_cart/core/effects/rolling_resistance.h"
-#include "birkhoff_cart/core/effects/steering_damping.h"
-#include "birkhoff_cart/core/effects/steering_stiffness.h"
+#include "birkhoff_cart/core/integrators/autodiff.h"
+#include "birkhoff_cart/core/physics/cart_model.h"
+#include "birkhoff_cart/core/physics/effects.h"
+#include "birkhoff_cart/core/physics/effects/air_drag.h"
+#include "birkhoff_cart/core/physics/effects/rolling_resistance.h"
+#include "birkhoff_cart/core/physics/effects/steering_damping.h"
+#include "birkhoff_cart/core/physics/effects/steering_stiffness.h"
 #include "full_coordinate_model.h"
 #include "generated_docs.h"
 

@@ -13,12 +13,12 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/cart_birkhoffian.h"
-#include "birkhoff_cart/core/effect_library.h"
+#include "birkhoff_cart/core/physics/cart_birkhoffian.h"
+#include "birkhoff_cart/core/physics/effect_library.h"
 #include "birkhoff_cart/core/examples/chaplygin_sleigh.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/integrators/integrator_members.h"
-#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/scene/scene.h"
 #include "generated_docs.h"
 #include "registry_members.h"
 #include "test_systems.h"

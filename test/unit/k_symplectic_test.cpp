@@ -13,11 +13,11 @@
 #include <random>
 #include <string>
 
-#include "birkhoff_cart/core/autodiff.h"
-#include "birkhoff_cart/core/birkhoffian_system.h"
-#include "birkhoff_cart/core/cart_birkhoffian.h"
-#include "birkhoff_cart/core/cart_model.h"
-#include "birkhoff_cart/core/effects.h"
+#include "birkhoff_cart/core/integrators/autodiff.h"
+#include "birkhoff_cart/core/integrators/birkhoffian_system.h"
+#include "birkhoff_cart/core/physics/cart_birkhoffian.h"
+#include "birkhoff_cart/core/physics/cart_model.h"
+#include "birkhoff_cart/core/physics/effects.h"
 #include "birkhoff_cart/core/examples/chaplygin_sleigh.h"
 #include "birkhoff_cart/core/integrators/birkhoff_symplectic.h"
 #include "birkhoff_cart/core/integrators/implicit_midpoint.h"

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <random>
 
-#include "birkhoff_cart/core/autodiff.h"
+#include "birkhoff_cart/core/integrators/autodiff.h"
 #include "birkhoff_cart/core/integrators/gauss_legendre_tableau.h"
 #include "birkhoff_cart/core/integrators/kronecker_newton.h"
 

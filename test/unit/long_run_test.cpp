@@ -11,10 +11,10 @@
 #include <string>
 #include <utility>
 
-#include "birkhoff_cart/core/cart_model.h"
-#include "birkhoff_cart/core/effects.h"
+#include "birkhoff_cart/core/physics/cart_model.h"
+#include "birkhoff_cart/core/physics/effects.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
-#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/scene/scene.h"
 
 namespace birkhoff_cart {
 namespace {

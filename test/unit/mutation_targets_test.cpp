@@ -58,7 +58,7 @@ TEST(MutationTargets, AMovedTargetIsReportedByName) {
     fs::copy(fs::canonical(fs::path(kSourceDirectory) / part), copy / part, fs::copy_options::recursive);
   }
   // A refactoring rewrites the turn count of the angle reduction.
-  const fs::path header = copy / "include/birkhoff_cart/core/angle_reduction.h";
+  const fs::path header = copy / "include/birkhoff_cart/core/integrators/angle_reduction.h";
   std::stringstream text;
   text << std::ifstream(header).rdbuf();
   std::string source = text.str();

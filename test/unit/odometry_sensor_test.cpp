@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/sensors/odometry_sensor.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/physics/sensors/odometry_sensor.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "generated_docs.h"
 #include "test_scenes.h"
 

@@ -9,9 +9,9 @@
 #include <cstdio>
 #include <string>
 
-#include "birkhoff_cart/core/paper_form_drift.h"
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/run/paper_form_drift.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "generated_docs.h"
 
 namespace birkhoff_cart {

@@ -6,8 +6,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "birkhoff_cart/core/cart_model.h"
-#include "birkhoff_cart/core/parameters.h"
+#include "birkhoff_cart/core/physics/cart_model.h"
+#include "birkhoff_cart/core/physics/parameters.h"
 
 namespace birkhoff_cart {
 namespace {

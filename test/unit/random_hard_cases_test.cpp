@@ -27,11 +27,11 @@
 #include <utility>
 #include <vector>
 
-#include "birkhoff_cart/core/accuracy_guard.h"
+#include "birkhoff_cart/core/scene/accuracy_guard.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
-#include "birkhoff_cart/core/random_scene.h"
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/run/random_scene.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "generated_docs.h"
 
 namespace birkhoff_cart {

@@ -23,12 +23,12 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/cart_model.h"
-#include "birkhoff_cart/core/effect_library.h"
+#include "birkhoff_cart/core/physics/cart_model.h"
+#include "birkhoff_cart/core/physics/effect_library.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/cart_binding/integrator_registry.h"
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "generated_docs.h"
 
 namespace birkhoff_cart {

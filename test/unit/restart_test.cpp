@@ -9,9 +9,9 @@
 #include <limits>
 #include <string>
 
-#include "birkhoff_cart/core/restart_state.h"
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/physics/restart_state.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/run/simulation.h"
 
 namespace birkhoff_cart {
 namespace {

@@ -13,12 +13,12 @@
 #include <memory>
 #include <string>
 
-#include "birkhoff_cart/core/cart_birkhoffian.h"
+#include "birkhoff_cart/core/physics/cart_birkhoffian.h"
 #include "birkhoff_cart/core/integrators/birkhoff_symplectic.h"
 #include "birkhoff_cart/core/cart_binding/carried_state.h"
 #include "birkhoff_cart/core/integrators/reversible_step_control.h"
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "test_scenes.h"
 
 namespace birkhoff_cart {
@@ -276,7 +276,7 @@ TEST(ReversibleStepControl, BadSettingsAreRefusedByName) {
   // A tolerance out of the member's reach is refused when the simulation is built (CLI exit 3,
   // node start-up error), not at its first step.
   try {
-    Simulation tight(reversible_whirl("birkhoff2", 1e-14, 4.0, 0.5));
+    Simulation tight(reversible_whirl("birkhoff2", 2e-12, 4.0, 0.5));  // above the floor of 1.8e-12 m
     FAIL() << "a tolerance out of birkhoff2's reach was accepted";
   } catch (const std::invalid_argument& error) {
     EXPECT_NE(std::string(error.what()).find("out of reach"), std::string::npos) << error.what();

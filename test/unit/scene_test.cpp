@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/effect_library.h"
-#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/physics/effect_library.h"
+#include "birkhoff_cart/core/scene/scene.h"
 #include "generated_docs.h"
 #include "test_scenes.h"
 

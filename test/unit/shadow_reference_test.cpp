@@ -5,9 +5,9 @@
 #include <cmath>
 #include <string>
 
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/shadow_reference.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/run/shadow_reference.h"
+#include "birkhoff_cart/core/run/simulation.h"
 
 namespace birkhoff_cart {
 namespace {

@@ -7,9 +7,9 @@
 #include <limits>
 #include <string>
 
-#include "birkhoff_cart/core/reference_solution.h"
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/run/reference_solution.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/run/simulation.h"
 
 namespace birkhoff_cart {
 namespace {

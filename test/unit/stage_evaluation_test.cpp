@@ -15,11 +15,11 @@
 #include <stdexcept>
 #include <string>
 
-#include "birkhoff_cart/core/cart_birkhoffian.h"
+#include "birkhoff_cart/core/physics/cart_birkhoffian.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
-#include "birkhoff_cart/core/deterministic_math.h"
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/vector_math.h"
+#include "birkhoff_cart/core/integrators/deterministic_math.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/integrators/vector_math.h"
 #include "generated_docs.h"
 
 namespace birkhoff_cart {

@@ -9,9 +9,9 @@
 #include <random>
 #include <string>
 
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/simulation.h"
-#include "birkhoff_cart/core/step_schedule.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/run/simulation.h"
+#include "birkhoff_cart/core/scene/step_schedule.h"
 #include "test_scenes.h"
 
 namespace birkhoff_cart {

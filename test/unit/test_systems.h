@@ -1,15 +1,15 @@
 // Birkhoffian test systems with known solutions, modelling the concept of
-// include/birkhoff_cart/core/birkhoffian_system.h (sign convention docs/birkhoffian.md eq. (B.1)):
+// include/birkhoff_cart/core/integrators/birkhoffian_system.h (sign convention docs/birkhoffian.md eq. (B.1)):
 //   K ż = ∇B + ∂R/∂t + Λ,   K_ij = ∂R_j/∂z_i − ∂R_i/∂z_j.
 // Shared by the integrator tests (birkhoff and peers). The cart's Birkhoffian systems live in
-// include/birkhoff_cart/core/cart_birkhoffian.h.
+// include/birkhoff_cart/core/physics/cart_birkhoffian.h.
 #pragma once
 
 #include <Eigen/Core>
 #include <cmath>
 
-#include "birkhoff_cart/core/autodiff.h"
-#include "birkhoff_cart/core/birkhoffian_system.h"
+#include "birkhoff_cart/core/integrators/autodiff.h"
+#include "birkhoff_cart/core/integrators/birkhoffian_system.h"
 
 namespace birkhoff_cart {
 namespace testing {

@@ -20,14 +20,14 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/accuracy_floors.h"
-#include "birkhoff_cart/core/actuators/steering_end_stops.h"
+#include "birkhoff_cart/core/run/accuracy_floors.h"
+#include "birkhoff_cart/core/physics/actuators/steering_end_stops.h"
 #include "birkhoff_cart/core/integrators/adaptive_refusal.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/cart_binding/integrator_registry.h"
-#include "birkhoff_cart/core/run_summary.h"
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/run/run_summary.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "test_scenes.h"
 
 namespace birkhoff_cart {

@@ -22,11 +22,11 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/cart_model.h"
-#include "birkhoff_cart/core/effect_library.h"
+#include "birkhoff_cart/core/physics/cart_model.h"
+#include "birkhoff_cart/core/physics/effect_library.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "full_coordinate_model.h"
 
 namespace birkhoff_cart {

@@ -9,8 +9,8 @@
 #include <diagnostic_updater/DiagnosticStatusWrapper.h>
 #include <ros/node_handle.h>
 
-#include "birkhoff_cart/core/accuracy_guard.h"
-#include "birkhoff_cart/core/diagnostics.h"
+#include "birkhoff_cart/core/scene/accuracy_guard.h"
+#include "birkhoff_cart/core/integrators/diagnostics.h"
 
 namespace birkhoff_cart {
 namespace ros_accuracy {

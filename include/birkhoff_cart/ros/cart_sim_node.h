@@ -47,10 +47,10 @@
 #include <std_srvs/SetBool.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include "birkhoff_cart/core/guarded_run.h"
+#include "birkhoff_cart/core/run/guarded_run.h"
 #include "birkhoff_cart/SetCartState.h"
-#include "birkhoff_cart/core/sensors/odometry_sensor.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/physics/sensors/odometry_sensor.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "birkhoff_cart/ros/run_record.h"
 #include "birkhoff_cart/core/node_logic/run_work_meter.h"
 #include "birkhoff_cart/ros/cart_sim_parameters.h"

@@ -8,7 +8,7 @@
 
 #include <ros/node_handle.h>
 
-#include "birkhoff_cart/core/integrator_settings.h"
+#include "birkhoff_cart/core/integrators/integrator_settings.h"
 #include "birkhoff_cart/ros/conversions.h"
 
 namespace birkhoff_cart {

@@ -12,9 +12,9 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 
-#include "birkhoff_cart/core/accuracy_guard.h"
-#include "birkhoff_cart/core/sensors/odometry_sensor.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/scene/accuracy_guard.h"
+#include "birkhoff_cart/core/physics/sensors/odometry_sensor.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
 #include "birkhoff_cart/ros/command_inputs.h"
 #include "birkhoff_cart/ros/run_record.h"

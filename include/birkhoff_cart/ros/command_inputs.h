@@ -16,7 +16,7 @@
 #include <ros/ros.h>
 #include <std_msgs/Float64.h>
 
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
 #include "birkhoff_cart/core/node_logic/command_channel.h"
 

@@ -13,11 +13,11 @@
 
 #include "birkhoff_cart/core/node_logic/run_timeline.h"
 #include "birkhoff_cart/IntegrationError.h"
-#include "birkhoff_cart/core/sensors/odometry_sensor.h"
-#include "birkhoff_cart/core/cart_model.h"
-#include "birkhoff_cart/core/diagnostics.h"
-#include "birkhoff_cart/core/simulation.h"
-#include "birkhoff_cart/core/state.h"
+#include "birkhoff_cart/core/physics/sensors/odometry_sensor.h"
+#include "birkhoff_cart/core/physics/cart_model.h"
+#include "birkhoff_cart/core/integrators/diagnostics.h"
+#include "birkhoff_cart/core/run/simulation.h"
+#include "birkhoff_cart/core/physics/state.h"
 
 namespace birkhoff_cart {
 namespace ros_conversions {

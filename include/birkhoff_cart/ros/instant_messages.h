@@ -14,8 +14,8 @@
 #include <tf2_msgs/TFMessage.h>
 
 #include "birkhoff_cart/IntegrationError.h"
-#include "birkhoff_cart/core/accuracy_guard.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/scene/accuracy_guard.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "birkhoff_cart/ros/conversions.h"
 
 namespace birkhoff_cart {

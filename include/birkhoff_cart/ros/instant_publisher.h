@@ -11,9 +11,9 @@
 #include <rosgraph_msgs/Clock.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include "birkhoff_cart/core/accuracy_guard.h"
-#include "birkhoff_cart/core/sensors/odometry_sensor.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/scene/accuracy_guard.h"
+#include "birkhoff_cart/core/physics/sensors/odometry_sensor.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
 #include "birkhoff_cart/ros/instant_messages.h"
 #include "birkhoff_cart/ros/output.h"

@@ -18,7 +18,7 @@
 #include <tf2_msgs/TFMessage.h>
 
 #include "birkhoff_cart/SetCartState.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
 
 namespace birkhoff_cart {

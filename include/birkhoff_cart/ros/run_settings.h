@@ -12,8 +12,8 @@
 #include <ros/ros.h>
 
 #include "birkhoff_cart/CartSimConfig.h"
-#include "birkhoff_cart/core/accuracy_guard.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/scene/accuracy_guard.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "birkhoff_cart/ros/cart_sim_parameters.h"
 #include "birkhoff_cart/ros/command_inputs.h"
 

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/reference_solution.h"
-#include "birkhoff_cart/core/scene.h"
+#include "birkhoff_cart/core/run/reference_solution.h"
+#include "birkhoff_cart/core/scene/scene.h"
 #include "measurement.h"
 
 namespace birkhoff_cart {

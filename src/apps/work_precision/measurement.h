@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/state.h"
+#include "birkhoff_cart/core/physics/state.h"
 
 namespace birkhoff_cart {
 namespace work_precision {

@@ -17,9 +17,9 @@
 #include <string>
 
 #include "bench_scene.h"
-#include "birkhoff_cart/core/cart_birkhoffian.h"
+#include "birkhoff_cart/core/physics/cart_birkhoffian.h"
 #include "birkhoff_cart/core/integrators/odeint_step_adjuster.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "measurement.h"
 #include "ours.h"
 

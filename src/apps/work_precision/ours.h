@@ -8,7 +8,7 @@
 
 #include "bench_scene.h"
 #include "birkhoff_cart/core/cart_binding/integrator_registry.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "measurement.h"
 
 namespace birkhoff_cart {

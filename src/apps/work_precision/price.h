@@ -30,8 +30,8 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/scene.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/scene/scene.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "measurement.h"
 #include "odeint_peers.h"
 #include "ours.h"

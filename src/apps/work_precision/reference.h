@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "bench_scene.h"
-#include "birkhoff_cart/core/simulation.h"
+#include "birkhoff_cart/core/run/simulation.h"
 #include "odeint_peers.h"
 #include "ours.h"
 

@@ -24,12 +24,12 @@
 #include <string>
 
 #include "birkhoff_cart/core/cart_binding/carried_state.h"
-#include "birkhoff_cart/core/effects.h"
-#include "birkhoff_cart/core/integrator_settings.h"
+#include "birkhoff_cart/core/physics/effects.h"
+#include "birkhoff_cart/core/integrators/integrator_settings.h"
 #include "birkhoff_cart/core/integrators/adaptive_step_control.h"
 #include "controlled_cart_stepper.h"
 #include "step_checks.h"
-#include "tolerance_proportionality.h"
+#include "birkhoff_cart/core/integrators/tolerance_proportionality.h"
 
 namespace birkhoff_cart {
 

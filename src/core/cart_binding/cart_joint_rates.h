@@ -6,8 +6,8 @@
 #include <array>
 #include <cstdint>
 
-#include "birkhoff_cart/core/cart_birkhoffian.h"
-#include "birkhoff_cart/core/cart_model.h"
+#include "birkhoff_cart/core/physics/cart_birkhoffian.h"
+#include "birkhoff_cart/core/physics/cart_model.h"
 
 namespace birkhoff_cart {
 

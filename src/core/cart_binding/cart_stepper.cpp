@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "birkhoff_cart/core/closest_name.h"
+#include "birkhoff_cart/core/support/closest_name.h"
 #include "birkhoff_cart/core/integrators/adaptive_refusal.h"
 #include "step_checks.h"
 

@@ -9,8 +9,8 @@
 #include <sstream>
 #include <string>
 
-#include "birkhoff_cart/core/cart_model.h"
-#include "birkhoff_cart/core/effects.h"
+#include "birkhoff_cart/core/physics/cart_model.h"
+#include "birkhoff_cart/core/physics/effects.h"
 #include "birkhoff_cart/core/cart_binding/carried_state.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "step_checks.h"

@@ -16,7 +16,7 @@
 
 #include "birkhoff_cart/core/cart_binding/carried_state.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
-#include "birkhoff_cart/core/effects.h"
+#include "birkhoff_cart/core/physics/effects.h"
 #include "grid_dense_output.h"
 #include "output_instants.h"
 #include "step_checks.h"

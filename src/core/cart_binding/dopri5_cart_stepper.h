@@ -21,8 +21,8 @@
 #include <sstream>
 #include <string>
 
-#include "birkhoff_cart/core/effects.h"
-#include "birkhoff_cart/core/integrator_settings.h"
+#include "birkhoff_cart/core/physics/effects.h"
+#include "birkhoff_cart/core/integrators/integrator_settings.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/integrators/dopri5.h"
 #include "birkhoff_cart/core/integrators/odeint_step_adjuster.h"

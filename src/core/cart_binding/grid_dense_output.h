@@ -9,12 +9,12 @@
 #include <algorithm>
 #include <cmath>
 
-#include "birkhoff_cart/core/birkhoffian_system.h"
-#include "birkhoff_cart/core/diagnostics.h"
+#include "birkhoff_cart/core/integrators/birkhoffian_system.h"
+#include "birkhoff_cart/core/integrators/diagnostics.h"
 #include "birkhoff_cart/core/integrators/carried_point.h"
 #include "birkhoff_cart/core/integrators/hermite_dense_output.h"
 #include "birkhoff_cart/core/integrators/system_traits.h"
-#include "birkhoff_cart/core/state.h"
+#include "birkhoff_cart/core/physics/state.h"
 
 namespace birkhoff_cart {
 

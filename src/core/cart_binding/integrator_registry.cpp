@@ -12,8 +12,8 @@
 #include <type_traits>
 #include <utility>
 
-#include "birkhoff_cart/core/cart_birkhoffian.h"
-#include "birkhoff_cart/core/closest_name.h"
+#include "birkhoff_cart/core/physics/cart_birkhoffian.h"
+#include "birkhoff_cart/core/support/closest_name.h"
 #include "birkhoff_cart/core/cart_binding/carried_state.h"
 #include "birkhoff_cart/core/integrators/adaptive_refusal.h"
 #include "birkhoff_cart/core/integrators/integrator_members.h"

@@ -9,7 +9,7 @@
 #include <limits>
 #include <set>
 
-#include "birkhoff_cart/core/effects.h"
+#include "birkhoff_cart/core/physics/effects.h"
 
 namespace birkhoff_cart {
 

@@ -25,8 +25,8 @@
 #include <stdexcept>
 
 #include "birkhoff_cart/core/cart_binding/carried_state.h"
-#include "birkhoff_cart/core/effects.h"
-#include "birkhoff_cart/core/integrator_settings.h"
+#include "birkhoff_cart/core/physics/effects.h"
+#include "birkhoff_cart/core/integrators/integrator_settings.h"
 #include "birkhoff_cart/core/integrators/reversible_step_control.h"
 #include "birkhoff_cart/core/integrators/time_transformed_system.h"
 #include "controlled_cart_stepper.h"

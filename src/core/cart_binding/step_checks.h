@@ -10,10 +10,10 @@
 #include <stdexcept>
 #include <string>
 
-#include "birkhoff_cart/core/cart_model.h"
-#include "birkhoff_cart/core/integrator_settings.h"
+#include "birkhoff_cart/core/physics/cart_model.h"
+#include "birkhoff_cart/core/integrators/integrator_settings.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
-#include "birkhoff_cart/core/state.h"
+#include "birkhoff_cart/core/physics/state.h"
 
 namespace birkhoff_cart {
 namespace stepper_checks {

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <utility>
 
-#include "birkhoff_cart/core/closest_name.h"
+#include "birkhoff_cart/core/support/closest_name.h"
 
 namespace birkhoff_cart {
 

@@ -7,7 +7,7 @@
 #include <sstream>
 #include <utility>
 
-#include "birkhoff_cart/core/step_schedule.h"
+#include "birkhoff_cart/core/scene/step_schedule.h"
 
 namespace birkhoff_cart {
 namespace {

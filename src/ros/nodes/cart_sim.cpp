@@ -9,7 +9,7 @@
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
 
-#include "birkhoff_cart/core/version.h"
+#include "birkhoff_cart/core/support/version.h"
 #include "birkhoff_cart/ros/cart_sim_node.h"
 #include "birkhoff_cart/ros/node_main.h"
 #include "birkhoff_cart/ros/shutdown_signals.h"

@@ -4,7 +4,7 @@
 // not in joint_states within a second of the first), 4 unexpected error.
 #include <ros/ros.h>
 
-#include "birkhoff_cart/core/version.h"
+#include "birkhoff_cart/core/support/version.h"
 #include "birkhoff_cart/ros/cmd_vel_controller_node.h"
 #include "birkhoff_cart/ros/node_main.h"
 

@@ -17,7 +17,7 @@
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 
-#include "birkhoff_cart/core/version.h"
+#include "birkhoff_cart/core/support/version.h"
 #include "birkhoff_cart/ros/node_main.h"
 #include "birkhoff_cart/ros/shutdown_signals.h"
 

@@ -9,7 +9,7 @@
 
 #include <ros/ros.h>
 #include <std_msgs/Float64.h>
-#include "birkhoff_cart/core/version.h"
+#include "birkhoff_cart/core/support/version.h"
 #include "birkhoff_cart/ros/node_main.h"
 #include "birkhoff_cart/ros/parameter_reading.h"
 

@@ -7,7 +7,7 @@
 
 #include <ros/ros.h>
 
-#include "birkhoff_cart/core/version.h"
+#include "birkhoff_cart/core/support/version.h"
 #include "birkhoff_cart/ros/node_main.h"
 #include "birkhoff_cart/ros/steering_pd_controller.h"
 

@@ -7,11 +7,11 @@
 // handed out carries each angle as hi + lo (state.h), so that diagnostics keep those bits too.
 #pragma once
 
-#include "birkhoff_cart/core/angle_reduction.h"
-#include "birkhoff_cart/core/cart_birkhoffian.h"
+#include "birkhoff_cart/core/integrators/angle_reduction.h"
+#include "birkhoff_cart/core/physics/cart_birkhoffian.h"
 #include "birkhoff_cart/core/integrators/carried_point.h"
 #include "birkhoff_cart/core/integrators/gauss_collocation.h"
-#include "birkhoff_cart/core/state.h"
+#include "birkhoff_cart/core/physics/state.h"
 
 namespace birkhoff_cart {
 

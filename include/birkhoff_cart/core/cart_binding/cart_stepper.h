@@ -7,13 +7,13 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/cart_model.h"
-#include "birkhoff_cart/core/diagnostics.h"
-#include "birkhoff_cart/core/effects.h"
-#include "birkhoff_cart/core/integrator_settings.h"
+#include "birkhoff_cart/core/physics/cart_model.h"
+#include "birkhoff_cart/core/integrators/diagnostics.h"
+#include "birkhoff_cart/core/physics/effects.h"
+#include "birkhoff_cart/core/integrators/integrator_settings.h"
 #include "birkhoff_cart/core/cart_binding/integrator_registry.h"
 #include "birkhoff_cart/core/integrators/step_error.h"  // StepError, for every user of a CartStepper
-#include "birkhoff_cart/core/state.h"
+#include "birkhoff_cart/core/physics/state.h"
 
 namespace birkhoff_cart {
 

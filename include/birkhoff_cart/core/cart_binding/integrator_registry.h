@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "birkhoff_cart/core/integrator_settings.h"
+#include "birkhoff_cart/core/integrators/integrator_settings.h"
 #include "birkhoff_cart/core/integrators/integrator_kind.h"
 
 namespace birkhoff_cart {

@@ -42,7 +42,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "birkhoff_cart/core/birkhoffian_system.h"
+#include "birkhoff_cart/core/integrators/birkhoffian_system.h"
 
 namespace birkhoff_cart {
 

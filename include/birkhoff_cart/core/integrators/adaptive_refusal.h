@@ -1,5 +1,5 @@
 // The members the adaptive step control refuses although they have a local error estimate: their
-// estimate cannot steer the run to the tolerance asked (measured: docs/accuracy.md §4.3). The reason
+// estimate cannot steer the run to the tolerance asked (measured: docs/accuracy.md §4.4). The reason
 // is the member's own, in integrator_members.h; the registry's row then has no adaptive factory
 // (integrator_registry.cpp), and every face (make_cart_stepper, the scene reader, the CLI, the node,
 // the Python module) says why with adaptive_refusal_message.

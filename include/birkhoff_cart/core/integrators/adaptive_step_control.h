@@ -34,8 +34,8 @@
 #include <string>
 #include <type_traits>
 
-#include "birkhoff_cart/core/deterministic_math.h"
-#include "birkhoff_cart/core/diagnostics.h"
+#include "birkhoff_cart/core/integrators/deterministic_math.h"
+#include "birkhoff_cart/core/integrators/diagnostics.h"
 #include "birkhoff_cart/core/integrators/step_error.h"
 #include "birkhoff_cart/core/integrators/carried_point.h"
 #include "birkhoff_cart/core/integrators/compensated_summation.h"

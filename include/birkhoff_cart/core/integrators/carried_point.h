@@ -11,8 +11,8 @@
 #include <type_traits>
 #include <utility>
 
-#include "birkhoff_cart/core/angle_reduction.h"
-#include "birkhoff_cart/core/diagnostics.h"
+#include "birkhoff_cart/core/integrators/angle_reduction.h"
+#include "birkhoff_cart/core/integrators/diagnostics.h"
 #include "birkhoff_cart/core/integrators/compensated_summation.h"
 #include "birkhoff_cart/core/integrators/system_traits.h"
 

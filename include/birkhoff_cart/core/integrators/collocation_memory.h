@@ -10,7 +10,7 @@
 #include <cmath>
 #include <limits>
 
-#include "birkhoff_cart/core/birkhoffian_system.h"
+#include "birkhoff_cart/core/integrators/birkhoffian_system.h"
 #include "birkhoff_cart/core/integrators/gauss_legendre_tableau.h"
 #include "birkhoff_cart/core/integrators/kronecker_newton.h"
 

@@ -7,7 +7,7 @@
 #include <Eigen/Core>
 #include <type_traits>
 
-#include "birkhoff_cart/core/birkhoffian_system.h"
+#include "birkhoff_cart/core/integrators/birkhoffian_system.h"
 
 namespace birkhoff_cart {
 

@@ -46,8 +46,8 @@
 #include <string>
 #include <type_traits>
 
-#include "birkhoff_cart/core/birkhoffian_system.h"
-#include "birkhoff_cart/core/diagnostics.h"
+#include "birkhoff_cart/core/integrators/birkhoffian_system.h"
+#include "birkhoff_cart/core/integrators/diagnostics.h"
 #include "birkhoff_cart/core/integrators/step_error.h"
 #include "birkhoff_cart/core/integrators/odeint_step_adjuster.h"
 

@@ -15,8 +15,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "birkhoff_cart/core/autodiff.h"
-#include "birkhoff_cart/core/birkhoffian_system.h"
+#include "birkhoff_cart/core/integrators/autodiff.h"
+#include "birkhoff_cart/core/integrators/birkhoffian_system.h"
 
 namespace birkhoff_cart {
 

@@ -31,9 +31,9 @@
 #include <cstdint>
 #include <type_traits>
 
-#include "birkhoff_cart/core/autodiff.h"
-#include "birkhoff_cart/core/birkhoffian_system.h"
-#include "birkhoff_cart/core/diagnostics.h"
+#include "birkhoff_cart/core/integrators/autodiff.h"
+#include "birkhoff_cart/core/integrators/birkhoffian_system.h"
+#include "birkhoff_cart/core/integrators/diagnostics.h"
 #include "birkhoff_cart/core/integrators/step_error.h"
 #include "birkhoff_cart/core/integrators/collocation_error_estimate.h"
 #include "birkhoff_cart/core/integrators/collocation_memory.h"

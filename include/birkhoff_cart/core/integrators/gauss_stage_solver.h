@@ -30,9 +30,9 @@
 #include <limits>
 #include <type_traits>
 
-#include "birkhoff_cart/core/autodiff.h"
-#include "birkhoff_cart/core/birkhoffian_system.h"
-#include "birkhoff_cart/core/diagnostics.h"
+#include "birkhoff_cart/core/integrators/autodiff.h"
+#include "birkhoff_cart/core/integrators/birkhoffian_system.h"
+#include "birkhoff_cart/core/integrators/diagnostics.h"
 #include "birkhoff_cart/core/integrators/step_error.h"
 #include "birkhoff_cart/core/integrators/collocation_memory.h"
 #include "birkhoff_cart/core/integrators/gauss_legendre_tableau.h"

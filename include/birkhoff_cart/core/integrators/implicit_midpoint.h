@@ -23,8 +23,8 @@
 
 #include <Eigen/Core>
 
-#include "birkhoff_cart/core/birkhoffian_system.h"
-#include "birkhoff_cart/core/diagnostics.h"
+#include "birkhoff_cart/core/integrators/birkhoffian_system.h"
+#include "birkhoff_cart/core/integrators/diagnostics.h"
 #include <algorithm>
 #include <cmath>
 #include <limits>

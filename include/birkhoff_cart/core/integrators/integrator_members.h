@@ -26,7 +26,7 @@
 #include <type_traits>
 #include <utility>
 
-#include "birkhoff_cart/core/integrator_settings.h"
+#include "birkhoff_cart/core/integrators/integrator_settings.h"
 #include "birkhoff_cart/core/integrators/birkhoff_symplectic.h"
 #include "birkhoff_cart/core/integrators/dopri5.h"
 #include "birkhoff_cart/core/integrators/gauss_collocation.h"

@@ -32,8 +32,8 @@
 #include <sstream>
 #include <type_traits>
 
-#include "birkhoff_cart/core/autodiff.h"
-#include "birkhoff_cart/core/diagnostics.h"
+#include "birkhoff_cart/core/integrators/autodiff.h"
+#include "birkhoff_cart/core/integrators/diagnostics.h"
 #include "birkhoff_cart/core/integrators/step_error.h"
 
 namespace birkhoff_cart {

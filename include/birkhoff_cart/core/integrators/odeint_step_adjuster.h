@@ -14,7 +14,7 @@
 #include <algorithm>
 #include <boost/numeric/odeint.hpp>
 
-#include "birkhoff_cart/core/deterministic_math.h"
+#include "birkhoff_cart/core/integrators/deterministic_math.h"
 
 namespace birkhoff_cart {
 

@@ -17,8 +17,8 @@
 // upper estimate of the method's own local error (pessimistic by O(h^{p − p̂}), docs/accuracy.md).
 #pragma once
 
-#include "birkhoff_cart/core/birkhoffian_system.h"
-#include "birkhoff_cart/core/diagnostics.h"
+#include "birkhoff_cart/core/integrators/birkhoffian_system.h"
+#include "birkhoff_cart/core/integrators/diagnostics.h"
 #include "birkhoff_cart/core/integrators/error_estimate.h"
 #include "birkhoff_cart/core/integrators/integrator_kind.h"
 

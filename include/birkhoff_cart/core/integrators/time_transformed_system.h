@@ -28,8 +28,8 @@
 #include <cstddef>
 #include <type_traits>
 
-#include "birkhoff_cart/core/autodiff.h"
-#include "birkhoff_cart/core/birkhoffian_system.h"
+#include "birkhoff_cart/core/integrators/autodiff.h"
+#include "birkhoff_cart/core/integrators/birkhoffian_system.h"
 #include "birkhoff_cart/core/integrators/system_traits.h"
 
 namespace birkhoff_cart {

@@ -1,0 +1,59 @@
+// Rolling resistance of the four wheels, docs/derivation.md eq. (4.3).
+#include "birkhoff_cart/core/physics/effects/rolling_resistance.h"
+#include "birkhoff_cart/core/integrators/deterministic_math.h"
+
+#include <cmath>
+
+namespace birkhoff_cart {
+
+RollingResistance::RollingResistance(const CartModel& model, double coefficient, double speed_epsilon)
+    : model_(model), coefficient_(coefficient), speed_epsilon_(speed_epsilon) {
+  const CartParameters& p = model_.parameters();
+  const double rear_load = (0.5 * p.rear_body_mass + p.rear_wheel_mass) * p.gravity;   // [N]
+  const double front_load = (0.5 * p.front_axle_mass + p.front_wheel_mass) * p.gravity;  // [N]
+  normal_load_ = {rear_load, rear_load, front_load, front_load};
+}
+
+const std::string& RollingResistance::name() const {
+  static const std::string kName = "rolling_resistance";
+  return kName;
+}
+
+void RollingResistance::add_to(const EffectInput& input, GeneralizedForce& total) const {
+  const double chi = input.steering_angle;
+  const double w1 = input.forward_speed;
+  const double w2 = input.steering_rate;
+  std::array<double, 4> d1;
+  std::array<double, 4> d2;
+  model_.rim_speed_coefficients(chi, d1, d2);  // r_i φ̇_i = d1_i ω1 + d2_i ω2   (eq. (2.4))
+  // ∂d1_i/∂χ (d2 is constant).
+  const double s = deterministic::sin(chi);
+  const double c = deterministic::cos(chi);
+  const CartParameters& p = model_.parameters();
+  const double a_over_l = p.rear_half_track / p.wheelbase;
+  const double cf_over_l = p.front_half_track / p.wheelbase;
+  const std::array<double, 4> d1_chi = {-s - a_over_l * c, -s + a_over_l * c, -cf_over_l * c, cf_over_l * c};
+
+  for (int wheel = 0; wheel < 4; ++wheel) {
+    const double rim_speed = d1[wheel] * w1 + d2[wheel] * w2;  // v_i [m/s]
+    const double ratio = rim_speed / speed_epsilon_;          // [-]
+    const double tanh_ratio = deterministic::tanh(ratio);
+    const double sech2_ratio = 1.0 - tanh_ratio * tanh_ratio;
+    const double load = coefficient_ * normal_load_[wheel];  // c_rr N_i [N]
+    // Rim force F_i = τ_i / r_i = −c_rr N_i tanh(v_i/v_eps);  Q_σ += F_i d_σi   (eq. (4.3)).
+    const double rim_force = -load * tanh_ratio;                       // [N]
+    const double rim_force_slope = -load * sech2_ratio / speed_epsilon_;  // ∂F_i/∂v_i [N·s/m]
+    const double speed_chi = d1_chi[wheel] * w1;                        // ∂v_i/∂χ [m/s/rad]
+    total.force(0) += rim_force * d1[wheel];
+    total.force(1) += rim_force * d2[wheel];
+    // ∂Q_σ/∂χ = F_i' (∂v_i/∂χ) d_σi + F_i ∂d_σi/∂χ;  ∂Q_σ/∂ω_k = F_i' d_ki d_σi.
+    total.jacobian(0, 0) += rim_force_slope * speed_chi * d1[wheel] + rim_force * d1_chi[wheel];
+    total.jacobian(1, 0) += rim_force_slope * speed_chi * d2[wheel];
+    total.jacobian(0, 1) += rim_force_slope * d1[wheel] * d1[wheel];
+    total.jacobian(0, 2) += rim_force_slope * d2[wheel] * d1[wheel];
+    total.jacobian(1, 1) += rim_force_slope * d1[wheel] * d2[wheel];
+    total.jacobian(1, 2) += rim_force_slope * d2[wheel] * d2[wheel];
+  }
+}
+
+}  // namespace birkhoff_cart
