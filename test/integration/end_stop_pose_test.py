@@ -18,7 +18,7 @@ from birkhoff_cart.srv import StepRun
 
 STOP = 0.6          # the scene's steering_end_stops.angle [rad]
 PLACED = 0.02       # how far the cart may move in the steps after a teleport [m]
-STEPS_TO_REST = 400  # 4 s of the scene (h = 10 ms): the motor has turned the axle onto the stop
+STEPS_TO_REST = 600  # 6 s of the scene (h = 10 ms): the motor turns the axle from 2 s on and rests it on the stop by 4.5 s
 
 
 class EndStopPose(unittest.TestCase):
