@@ -5,7 +5,7 @@
 # running it again resumes (only tasks without a row run); --fresh starts over.
 #
 # Usage: scripts/run_benchmark.sh [--quick] [more study options, e.g. --workers 1, --scheduler tcp://HOST:PORT, --fresh]
-#   --quick: bench/studies/work_precision_quick.yaml into /tmp/birkhoff_cart_bench_quick/ (seconds)
+#   --quick: bench/studies/work_precision_quick.yaml into ${TMPDIR:-/tmp}/birkhoff_cart_bench_quick/ (seconds)
 # Environment: BIRKHOFF_CART_WORKSPACE = an already-built catkin workspace to use instead of
 #              running scripts/setup.sh (which builds .ws/).
 set -euo pipefail
@@ -19,7 +19,7 @@ arguments=()
 for argument in "$@"; do
   if [ "$argument" = "--quick" ]; then
     study="$repo/bench/studies/work_precision_quick.yaml"
-    output_dir=/tmp/birkhoff_cart_bench_quick
+    output_dir="${TMPDIR:-/tmp}/birkhoff_cart_bench_quick"
     report="$output_dir/results.md"
   else
     arguments+=("$argument")
