@@ -88,6 +88,43 @@ TEST_F(StageEvaluationTest, VectorPathGivesTheScalarPathsBitsOrIsRefusedByName) 
   EXPECT_EQ(differing, 0);
 }
 
+/// tanh_lanes on both paths against deterministic::tanh, on kBatches random batches of 1 …
+/// kMaxVectorLanes arguments: rim speed ratios in [−40, 40] (a wheel far beyond the band), in [−1, 1]
+/// (within it) and in [−1e-6, 1e-6] (at rest), and ±0, ±∞ and NaN. Returns the lanes that differ.
+long tanh_lanes_differing_from_scalar(unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  long differing = 0;
+  const double scales[3] = {40.0, 1.0, 1e-6};
+  for (int trial = 0; trial < kBatches; ++trial) {
+    double x[kMaxVectorLanes];
+    double out[kMaxVectorLanes];
+    const int count = 1 + trial % kMaxVectorLanes;
+    for (int i = 0; i < count; ++i) x[i] = scales[trial % 3] * unit(random);
+    tanh_lanes(x, count, out);
+    for (int i = 0; i < count; ++i) differing += !same_bits(out[i], deterministic::tanh(x[i]));
+  }
+  const double special[kMaxVectorLanes] = {0.0, -0.0, INFINITY, NAN};
+  double out[kMaxVectorLanes];
+  tanh_lanes(special, kMaxVectorLanes, out);
+  for (int i = 0; i < kMaxVectorLanes; ++i) differing += !same_bits(out[i], deterministic::tanh(special[i]));
+  return differing;
+}
+
+TEST_F(StageEvaluationTest, TanhLanesGiveTheDeterministicTanhsBitsOnBothPaths) {
+  set_stage_evaluation(StageEvaluation::kScalar);
+  const long scalar_differing = tanh_lanes_differing_from_scalar(7);
+  std::printf("[ compared ] tanh_lanes scalar path vs deterministic::tanh, %d batches of 1-4: %ld differ\n",
+              kBatches, scalar_differing);
+  EXPECT_EQ(scalar_differing, 0);
+  if (!vector_stage_evaluation_available()) GTEST_SKIP() << "no AVX: one path only";
+  set_stage_evaluation(StageEvaluation::kVector);
+  const long vector_differing = tanh_lanes_differing_from_scalar(8);
+  std::printf("[ compared ] tanh_lanes vector path vs deterministic::tanh, %d batches of 1-4: %ld differ\n",
+              kBatches, vector_differing);
+  EXPECT_EQ(vector_differing, 0);
+}
+
 TEST_F(StageEvaluationTest, StageRatesOnTheScalarPathAreThePointwiseRates) {
   set_stage_evaluation(StageEvaluation::kScalar);
   const CartModel model{CartParameters{}};

@@ -11,9 +11,10 @@
 #if defined(__x86_64__)
 #include <immintrin.h>
 // SLEEF's deterministic AVX functions, 4 doubles (sleef.h declares them only to translation units
-// compiled for AVX): the same bits as deterministic::sin and deterministic::cos lane by lane.
+// compiled for AVX): the same bits as deterministic::sin, cos and tanh lane by lane.
 extern "C" __m256d Sleef_cinz_sind4_u35avx(__m256d);
 extern "C" __m256d Sleef_cinz_cosd4_u35avx(__m256d);
+extern "C" __m256d Sleef_cinz_tanhd4_u35avx(__m256d);
 #endif
 
 namespace birkhoff_cart {
@@ -74,6 +75,14 @@ __attribute__((target("avx"))) void sin_cos_avx(const double* angles, int count,
     cosines[i] = cosine_lanes[i];
   }
 }
+
+__attribute__((target("avx"))) void tanh_avx(const double* x, int count, double* out) {
+  alignas(32) double lanes[kMaxVectorLanes] = {0.0, 0.0, 0.0, 0.0};
+  for (int i = 0; i < count; ++i) lanes[i] = x[i];
+  alignas(32) double tanh_lanes[kMaxVectorLanes];
+  _mm256_store_pd(tanh_lanes, Sleef_cinz_tanhd4_u35avx(_mm256_load_pd(lanes)));
+  for (int i = 0; i < count; ++i) out[i] = tanh_lanes[i];
+}
 #endif
 
 }  // namespace
@@ -107,6 +116,16 @@ void sin_cos_lanes(const double* angles, int count, double* sines, double* cosin
   }
 #endif
   sin_cos_scalar(angles, count, sines, cosines);
+}
+
+void tanh_lanes(const double* x, int count, double* out) {
+#if defined(__x86_64__)
+  if (current_stage_evaluation() == StageEvaluation::kVector) {
+    tanh_avx(x, count, out);
+    return;
+  }
+#endif
+  for (int i = 0; i < count; ++i) out[i] = deterministic::tanh(x[i]);
 }
 
 }  // namespace birkhoff_cart

@@ -1,6 +1,7 @@
 // Rolling resistance of the four wheels, docs/derivation.md eq. (4.3).
 #include "birkhoff_cart/core/physics/effects/rolling_resistance.h"
 #include "birkhoff_cart/core/integrators/deterministic_math.h"
+#include "birkhoff_cart/core/integrators/vector_math.h"
 
 #include <cmath>
 
@@ -34,10 +35,14 @@ void RollingResistance::add_to(const EffectInput& input, GeneralizedForce& total
   const double cf_over_l = p.front_half_track / p.wheelbase;
   const std::array<double, 4> d1_chi = {-s - a_over_l * c, -s + a_over_l * c, -cf_over_l * c, cf_over_l * c};
 
+  // tanh(v_i/v_eps) of the four wheels in one call (vector_math.h: one AVX call where the CPU has
+  // it, the same bits as four scalar ones); it was a fifth of the instructions of a drive scene.
+  double ratios[4];  // v_i / v_eps [-], v_i = r_i φ̇_i [m/s]
+  for (int wheel = 0; wheel < 4; ++wheel) ratios[wheel] = (d1[wheel] * w1 + d2[wheel] * w2) / speed_epsilon_;
+  double tanh_ratios[4];
+  tanh_lanes(ratios, 4, tanh_ratios);
   for (int wheel = 0; wheel < 4; ++wheel) {
-    const double rim_speed = d1[wheel] * w1 + d2[wheel] * w2;  // v_i [m/s]
-    const double ratio = rim_speed / speed_epsilon_;          // [-]
-    const double tanh_ratio = deterministic::tanh(ratio);
+    const double tanh_ratio = tanh_ratios[wheel];
     const double sech2_ratio = 1.0 - tanh_ratio * tanh_ratio;
     const double load = coefficient_ * normal_load_[wheel];  // c_rr N_i [N]
     // Rim force F_i = τ_i / r_i = −c_rr N_i tanh(v_i/v_eps);  Q_σ += F_i d_σi   (eq. (4.3)).
