@@ -24,6 +24,7 @@
 #include "birkhoff_cart/core/scene/scene.h"
 #include "birkhoff_cart/core/support/version.h"
 #include "birkhoff_cart/core/run/guarded_run.h"
+#include "own_system_bindings.h"
 #include "scene_source.h"
 
 namespace py = pybind11;
@@ -481,4 +482,6 @@ PYBIND11_MODULE(simulator, m) {
                              "The steering torque in force [N·m].")
       .def_property_readonly("drive_command", read_locked([](const Simulation& s) { return s.drive_command(); }),
                              "The drive torque in force [N·m].");
+
+  python::bind_own_system(m);
 }

@@ -16,6 +16,7 @@
 #include "birkhoff_cart/core/integrators/adaptive_step_control.h"
 #include "birkhoff_cart/core/integrators/carried_point.h"
 #include "birkhoff_cart/core/integrators/reversible_step_control.h"
+#include "birkhoff_cart/core/integrators/system_integration.h"
 #include "registry_members.h"
 
 namespace birkhoff_cart {
@@ -43,12 +44,7 @@ Eigen::Vector4d start_state(const Sleigh& sleigh) {
 /// A carried point of `System` at z [its units], y = 0, with its angles reduced.
 template <class System, class Memory>
 CarriedPoint<System, Memory> seed(const System& system, const Eigen::Vector4d& z) {
-  CarriedPoint<System, Memory> point;
-  point.point.z = z;
-  point.periodic_angles = system_traits::periodic_angles(system);
-  point.reduce_angles();
-  point.valid = true;
-  return point;
+  return seeded_point<System, Memory>(system, z);
 }
 
 /// The largest weighted difference (ê's weights, error_estimate.h) of a carried z, θ unwrapped by its

@@ -1,0 +1,307 @@
+// One run of any Birkhoffian system (birkhoffian_system.h) by a Birkhoffian member of the registry,
+// at fixed steps or under a step control, from t₀ to t₁, with the states on the member's own steps:
+// the loop a user's system needs (the cart has its own, run/simulation.h). docs/python.md, "Your own
+// Birkhoffian system"; the Python module's simulator.integrate is this function on a system whose
+// functions are Python callables (src/python/python_system.h).
+//
+//  - fixed: N = ⌈(t₁ − t₀)/h − 10⁻⁹⌉ steps of h, the last one shortened to land on t₁;
+//  - adaptive: the error-per-step control (adaptive_step_control.h) aimed at τ = tolerance/(t₁ − t₀)
+//    [1/s] in ê's weights (error_estimate.h), so that the estimates sum to at most the tolerance;
+//    its accepted steps. Not the cart's calibrated aim τ_a (tolerance_proportionality.h, eq.
+//    (B.53)): measured on the cart's scenes, it ended 5.7x beyond a 1e-4 tolerance on the quartic
+//    oscillator of docs/python.md over 100 s, whose phase error grows along the run;
+//  - reversible: the reversible control (reversible_step_control.h) for the tolerance, its grid up to
+//    the last point before t₁, then one step of the member from that point to t₁ (the grid itself
+//    passes t₁; the landing step is not part of it). Needs the identity chart (an autonomous system).
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "birkhoff_cart/core/integrators/adaptive_step_control.h"
+#include "birkhoff_cart/core/integrators/birkhoffian_system.h"
+#include "birkhoff_cart/core/integrators/carried_point.h"
+#include "birkhoff_cart/core/integrators/diagnostics.h"
+#include "birkhoff_cart/core/integrators/integrator_kind.h"
+#include "birkhoff_cart/core/integrators/integrator_members.h"
+#include "birkhoff_cart/core/integrators/integrator_settings.h"
+#include "birkhoff_cart/core/integrators/reversible_step_control.h"
+#include "birkhoff_cart/core/integrators/step_error.h"
+#include "birkhoff_cart/core/integrators/system_traits.h"
+#include "birkhoff_cart/core/integrators/time_transformed_system.h"
+
+namespace birkhoff_cart {
+
+/// How the steps of a system run are chosen.
+enum class SystemStepControl { kFixed, kAdaptive, kReversible };
+
+/// What a system run asks for.
+struct SystemRunRequest {
+  std::string integrator = "birkhoff_gauss8";  ///< a Birkhoffian member of the registry
+  SystemStepControl control = SystemStepControl::kFixed;
+  double step_size = 0.0;  ///< fixed: h [s] > 0; adaptive: the first attempt (0: (t₁ − t₀)/100) [s]
+  double tolerance = 0.0;  ///< the step controls: the error at t₁ in ê's weights [-] > 0
+  std::uint64_t max_steps = 1000000;  ///< work limit: steps (accepted or not) before the run ends by name
+};
+
+/// A run's result: the states on the member's own steps, t₀ first and t₁ last.
+template <class System>
+struct SystemRunResult {
+  std::vector<double> times;                            ///< [s]
+  std::vector<StateVector<System, double>> states;      ///< z at times [the system's units]
+  StepStatistics statistics;                            ///< evaluations, steps, rejected attempts
+  bool finished = false;   ///< reached t₁
+  std::string message;     ///< why it stopped
+};
+
+/// A carried point of `System` at z [its units], y = 0, its angles reduced: where a run starts.
+template <class System, class Memory>
+CarriedPoint<System, Memory> seeded_point(const System& system, const StateVector<System, double>& z) {
+  CarriedPoint<System, Memory> point;
+  point.point.z = z;
+  point.periodic_angles = system_traits::periodic_angles(system);
+  point.reduce_angles();
+  point.valid = true;
+  return point;
+}
+
+namespace system_integration_detail {
+
+/// The Gauss members with two stages or more: the ones the step controls take here (their estimate
+/// is of order s + 2; birkhoff2's and the compositions' are refused under the adaptive control,
+/// integrator_members.h).
+template <class Stepper>
+struct IsGaussMember : std::false_type {};
+template <int Stages>
+struct IsGaussMember<GaussCollocation<Stages>> : std::integral_constant<bool, (Stages >= 2)> {};
+template <class Stepper>
+constexpr bool kIsGaussMember = IsGaussMember<Stepper>::value;
+
+
+/// z of a carried point with its turns put back and its remainder added [the system's units].
+template <class System, class Point>
+StateVector<System, double> unreduced(const Point& carried) {
+  StateVector<System, double> z = carried.point.z.template head<System::kDimension>() +
+                                  carried.point.z_remainder.template head<System::kDimension>();
+  constexpr auto angles = system_traits::kAngleCoordinates<System>;
+  for (std::size_t k = 0; k < angles.size(); ++k) {
+    if (!angles[k].passive) z(angles[k].index) += 2.0 * M_PI * carried.turns[k];
+  }
+  return z;
+}
+
+template <class Stepper, class System>
+void run_fixed(const Stepper& stepper, System& system, double t0, double t1, const SystemRunRequest& request,
+               SystemRunResult<System>& result) {
+  const double h = request.step_size;
+  if (!(h > 0.0) || !std::isfinite(h)) throw std::invalid_argument("step_size must be finite and > 0 s at fixed steps");
+  const double span = t1 - t0;
+  const double count = std::ceil(span / h - 1e-9);
+  if (count > static_cast<double>(request.max_steps)) {
+    std::ostringstream message;
+    message << "step_size " << h << " s needs " << count << " steps over " << span << " s, beyond max_steps "
+            << request.max_steps;
+    throw std::invalid_argument(message.str());
+  }
+  const auto steps = static_cast<std::uint64_t>(count);
+  auto point = seeded_point<System, typename Stepper::template Memory<System>>(system, result.states.front());
+  for (std::uint64_t n = 1; n <= steps; ++n) {
+    const double t = t0 + static_cast<double>(n - 1) * h;
+    const double t_next = n == steps ? t1 : t0 + static_cast<double>(n) * h;
+    system_traits::begin_step(system, t);
+    stepper.advance_compensated(system, point.point, point.memory, t, t_next - t, result.statistics);
+    point.reduce_angles();
+    ++result.statistics.internal_steps;
+    result.times.push_back(t_next);
+    result.states.push_back(unreduced<System>(point));
+  }
+}
+
+template <class Stepper, class System>
+void run_adaptive(const Stepper& stepper, System& system, double t0, double t1, const SystemRunRequest& request,
+                  SystemRunResult<System>& result) {
+  using Carried = CarriedPoint<System, typename Stepper::template Memory<System>>;
+  AdaptiveStepSettings settings;
+  settings.error_per_unit_step = request.tolerance / (t1 - t0);
+  settings.max_steps_per_advance = request.max_steps;
+  AdaptiveStepControl<Stepper, System, Carried> control(stepper, settings);
+  const double first = request.step_size > 0.0 ? request.step_size : (t1 - t0) / 100.0;
+  control.start(seeded_point<System, typename Stepper::template Memory<System>>(system, result.states.front()), t0, first);
+  while (control.time() < t1) {
+    if (result.statistics.internal_steps + result.statistics.rejected_steps >= request.max_steps) {
+      std::ostringstream message;
+      message << "the adaptive control took max_steps = " << request.max_steps << " steps and attempts before t = "
+              << t1 << " s (at t = " << control.time() << " s)";
+      throw StepError(message.str());
+    }
+    control.step(system, t1, result.statistics);
+    result.times.push_back(control.time());
+    result.states.push_back(unreduced<System>(control.grid()));
+  }
+}
+
+template <class Stepper, class System>
+void run_reversible(const Stepper& stepper, const System& system, double t0, double t1,
+                    const SystemRunRequest& request, SystemRunResult<System>& result) {
+  using Control = ReversibleToleranceControl<Stepper, System>;
+  typename Control::Transformed transformed{system, t0};
+  Control control{stepper, transformed, request.tolerance / (t1 - t0), t1 - t0};
+  const auto start = seeded_point<System, NoStepMemory>(system, result.states.front());
+  control.calibrate(start, t0, result.statistics);
+  control.start(start, t0);
+  control.advance_past(t1, result.statistics, [&] {
+    if (result.times.size() >= request.max_steps) {
+      std::ostringstream message;
+      message << "the reversible control's grid reached max_steps = " << request.max_steps << " points before t = "
+              << t1 << " s";
+      throw StepError(message.str());
+    }
+    if (control.time() < t1) {
+      result.times.push_back(control.time());
+      result.states.push_back(unreduced<System>(control.grid()));
+    }
+  });
+  // Land on t₁ with one step of the member from the last grid point before it (or on it).
+  const double t_last = result.times.back();
+  if (t_last < t1) {
+    StateVector<System, double> z = result.states.back();
+    PassiveVector<System, double> y = PassiveVector<System, double>::Zero();
+    stepper.step(system, z, y, t_last, t1 - t_last, result.statistics);
+    result.times.push_back(t1);
+    result.states.push_back(z);
+  }
+}
+
+}  // namespace system_integration_detail
+
+/// Is `name` a Birkhoffian member, and which controls does it take here?
+struct SystemMemberInfo {
+  bool found = false;
+  bool adaptive = false;    ///< the Gauss members with two stages or more
+  bool reversible = false;  ///< the same, where the system's chart is the identity
+};
+
+template <class System>
+SystemMemberInfo system_member_info(const std::string& name) {
+  SystemMemberInfo info;
+  std::apply(
+      [&](const auto&... member) {
+        (
+            [&](const auto& m) {
+              using Stepper = typename std::decay_t<decltype(m)>::Type;
+              if constexpr (is_birkhoffian(member_kind<Stepper>())) {
+                if (name == Stepper::name()) {
+                  info.found = true;
+                  if constexpr (system_integration_detail::kIsGaussMember<Stepper>) {
+                    info.adaptive = true;
+                    info.reversible = system_traits::kDarbouxChartIsIdentity<System>;
+                  }
+                }
+              }
+            }(member),
+            ...);
+      },
+      kIntegratorMembers);
+  return info;
+}
+
+/// The Birkhoffian members' names, in the registry's order.
+inline std::vector<std::string> birkhoffian_member_names() {
+  std::vector<std::string> names;
+  std::apply(
+      [&](const auto&... member) {
+        (
+            [&](const auto& m) {
+              using Stepper = typename std::decay_t<decltype(m)>::Type;
+              if constexpr (is_birkhoffian(member_kind<Stepper>())) names.emplace_back(Stepper::name());
+            }(member),
+            ...);
+      },
+      kIntegratorMembers);
+  return names;
+}
+
+/// Integrates `system` from z₀ at t₀ [s] to t₁ [s] > t₀ as `request` says. Bad requests (an unknown
+/// or non-Birkhoffian member, a control the member does not take here, a step or tolerance that is
+/// not finite and positive) throw std::invalid_argument naming them. A step that fails for good
+/// (StepError: a stage solve at fixed steps, the controls' work limits and step floors) ends the run
+/// with `finished` false and its message; the states before it are kept. Anything else the system's
+/// functions throw passes through.
+template <class System>
+SystemRunResult<System> integrate_system(System& system, const StateVector<System, double>& z0, double t0, double t1,
+                                         const SystemRunRequest& request) {
+  if (!std::isfinite(t0) || !std::isfinite(t1) || !(t1 > t0)) {
+    throw std::invalid_argument("the time span needs finite t0 < t1 [s]");
+  }
+  if (!z0.allFinite()) throw std::invalid_argument("the initial state z0 holds a value that is not finite");
+  const SystemMemberInfo info = system_member_info<System>(request.integrator);
+  if (!info.found) {
+    std::ostringstream message;
+    message << "integrator '" << request.integrator << "' is not a Birkhoffian member; take one of:";
+    for (const std::string& name : birkhoffian_member_names()) message << " " << name;
+    throw std::invalid_argument(message.str());
+  }
+  if (request.control != SystemStepControl::kFixed) {
+    if (!(request.tolerance > 0.0) || !std::isfinite(request.tolerance)) {
+      throw std::invalid_argument("a step control needs a finite tolerance > 0");
+    }
+    const bool taken = request.control == SystemStepControl::kAdaptive ? info.adaptive : info.reversible;
+    if (!taken) {
+      std::ostringstream message;
+      message << "step control '" << (request.control == SystemStepControl::kAdaptive ? "adaptive" : "reversible")
+              << "' is not for '" << request.integrator << "' on this system: it takes birkhoff_gauss4, "
+              << "birkhoff_gauss6 and birkhoff_gauss8"
+              << (request.control == SystemStepControl::kReversible ? ", and only without a Darboux chart of "
+                                                                       "its own (the identity chart)"
+                                                                     : "")
+              << "; run it at fixed steps";
+      throw std::invalid_argument(message.str());
+    }
+  }
+  SystemRunResult<System> result;
+  result.times.push_back(t0);
+  result.states.push_back(z0);
+  std::apply(
+      [&](const auto&... member) {
+        (
+            [&](const auto& m) {
+              using Stepper = typename std::decay_t<decltype(m)>::Type;
+              if constexpr (is_birkhoffian(member_kind<Stepper>())) {
+                if (request.integrator != Stepper::name()) return;
+                const Stepper stepper = configured_stepper<Stepper>(IntegratorSettings{});
+                try {
+                  if (request.control == SystemStepControl::kFixed) {
+                    system_integration_detail::run_fixed(stepper, system, t0, t1, request, result);
+                  }
+                  if constexpr (system_integration_detail::kIsGaussMember<Stepper>) {
+                    if (request.control == SystemStepControl::kAdaptive) {
+                      system_integration_detail::run_adaptive(stepper, system, t0, t1, request, result);
+                    }
+                    if constexpr (system_traits::kDarbouxChartIsIdentity<System>) {
+                      if (request.control == SystemStepControl::kReversible) {
+                        system_integration_detail::run_reversible(stepper, system, t0, t1, request, result);
+                      }
+                    }
+                  }
+                  result.finished = true;
+                  result.message = "the run reached t1";
+                } catch (const StepError& error) {
+                  result.finished = false;
+                  result.message = error.what();
+                }
+              }
+            }(member),
+            ...);
+      },
+      kIntegratorMembers);
+  return result;
+}
+
+}  // namespace birkhoff_cart
