@@ -37,6 +37,8 @@ struct SleighSystem {
 struct SystemSolution {
   py::array_t<double> t;  ///< (n,) [s]
   py::array_t<double> y;  ///< (dimension, n)
+  py::list t_events;      ///< per event: the times of its crossings [s]
+  py::list y_events;      ///< per event: (crossings, dimension) states there
   std::uint64_t nfev = 0;
   py::object njev = py::none();
   std::uint64_t nsteps = 0;
@@ -46,7 +48,7 @@ struct SystemSolution {
   std::string message;
   std::string integrator;
   std::string step_control;
-  bool success() const { return status == 0; }
+  bool success() const { return status >= 0; }
 };
 
 py::object checked_callable(const py::object& value, const char* name, bool required) {
@@ -101,10 +103,52 @@ SystemStepControl control_from(const std::string& name) {
   throw py::value_error("step_control must be 'fixed', 'adaptive' or 'reversible', got '" + name + "'");
 }
 
+/// The events of integrate(): a callable g(t, z), or a sequence of them, each with the optional
+/// attributes `terminal` (bool) and `direction` (number; its sign counts), as scipy's solve_ivp.
+template <class System>
+std::vector<SystemEvent<System>> events_from(const py::object& given) {
+  std::vector<SystemEvent<System>> events;
+  if (given.is_none()) return events;
+  std::vector<py::object> functions;
+  if (PyCallable_Check(given.ptr())) {
+    functions.push_back(given);
+  } else {
+    for (const py::handle item : py::iter(given)) functions.push_back(py::reinterpret_borrow<py::object>(item));
+  }
+  for (std::size_t k = 0; k < functions.size(); ++k) {
+    const py::object function = functions[k];
+    if (!PyCallable_Check(function.ptr())) {
+      throw py::type_error("events[" + std::to_string(k) + "] must be a callable g(t, z), got " +
+                           py::repr(function).cast<std::string>());
+    }
+    SystemEvent<System> event;
+    event.terminal = py::hasattr(function, "terminal") && py::bool_(function.attr("terminal"));
+    if (py::hasattr(function, "direction")) {
+      const double direction = function.attr("direction").cast<double>();
+      event.direction = direction > 0.0 ? 1 : (direction < 0.0 ? -1 : 0);
+    }
+    event.function = [function, k](double t, const StateVector<System, double>& z) {
+      py::array_t<double> state(System::kDimension);
+      for (int i = 0; i < System::kDimension; ++i) state.mutable_at(i) = z(i);
+      const py::object value = function(t, state);
+      try {
+        return value.cast<double>();
+      } catch (const py::cast_error&) {
+        throw py::type_error("events[" + std::to_string(k) + "] must return a number, got " +
+                             py::repr(value).cast<std::string>());
+      }
+    };
+    events.push_back(std::move(event));
+  }
+  return events;
+}
+
 template <class System>
 SystemSolution solve(System& system, const py::array_t<double, py::array::c_style | py::array::forcecast>& z0,
-                     double t0, double t1, const SystemRunRequest& request, const std::uint64_t* jacobians) {
+                     double t0, double t1, const SystemRunRequest& request, const std::uint64_t* jacobians,
+                     const py::object& events_given) {
   constexpr int n = System::kDimension;
+  const std::vector<SystemEvent<System>> events = events_from<System>(events_given);
   if (z0.ndim() != 1 || z0.shape(0) != n) {
     throw py::value_error("z0 must hold " + std::to_string(n) + " numbers, got shape " +
                           py::repr(py::cast(std::vector<py::ssize_t>(z0.shape(), z0.shape() + z0.ndim())))
@@ -114,7 +158,7 @@ SystemSolution solve(System& system, const py::array_t<double, py::array::c_styl
   for (int i = 0; i < n; ++i) start(i) = z0.at(i);
   SystemRunResult<System> run;
   try {
-    run = integrate_system(system, start, t0, t1, request);
+    run = integrate_system(system, start, t0, t1, request, events);
   } catch (const std::invalid_argument& error) {
     throw py::value_error(error.what());
   }
@@ -131,7 +175,24 @@ SystemSolution solve(System& system, const py::array_t<double, py::array::c_styl
   solution.nsteps = run.statistics.internal_steps;
   solution.nrejected = run.statistics.rejected_steps;
   solution.newton_iterations = run.statistics.newton_iterations_total;
-  solution.status = run.finished ? 0 : -1;
+  for (std::size_t k = 0; k < events.size(); ++k) {
+    std::vector<double> times;
+    std::vector<const StateVector<System, double>*> states;
+    for (const SystemEventCrossing<System>& crossing : run.crossings) {
+      if (crossing.event != k) continue;
+      times.push_back(crossing.time);
+      states.push_back(&crossing.state);
+    }
+    py::array_t<double> event_times(static_cast<py::ssize_t>(times.size()));
+    py::array_t<double> event_states({static_cast<py::ssize_t>(times.size()), static_cast<py::ssize_t>(n)});
+    for (std::size_t c = 0; c < times.size(); ++c) {
+      event_times.mutable_at(static_cast<py::ssize_t>(c)) = times[c];
+      for (int i = 0; i < n; ++i) event_states.mutable_at(static_cast<py::ssize_t>(c), i) = (*states[c])(i);
+    }
+    solution.t_events.append(event_times);
+    solution.y_events.append(event_states);
+  }
+  solution.status = run.finished ? (run.terminal_event ? 1 : 0) : -1;
   solution.message = run.message;
   solution.integrator = request.integrator;
   return solution;
@@ -139,22 +200,22 @@ SystemSolution solve(System& system, const py::array_t<double, py::array::c_styl
 
 template <int Dimension>
 SystemSolution solve_user(const UserSystem& user, const py::array_t<double, py::array::c_style | py::array::forcecast>& z0,
-                          double t0, double t1, const SystemRunRequest& request) {
+                          double t0, double t1, const SystemRunRequest& request, const py::object& events) {
   std::uint64_t jacobians = 0;
   SystemFunctions functions = user.functions;
   functions.jacobian_evaluations = &jacobians;
   if (functions.to_darboux.is_none()) {
     PythonBirkhoffianSystem<Dimension, true> system(functions);
-    return solve(system, z0, t0, t1, request, &jacobians);
+    return solve(system, z0, t0, t1, request, &jacobians, events);
   }
   PythonBirkhoffianSystem<Dimension, false> system(functions);
-  return solve(system, z0, t0, t1, request, &jacobians);
+  return solve(system, z0, t0, t1, request, &jacobians, events);
 }
 
 SystemSolution integrate(const py::object& system, const py::array_t<double, py::array::c_style | py::array::forcecast>& z0,
                          const std::pair<double, double>& t_span, const std::string& integrator,
                          const py::object& step_size, const std::string& step_control, const py::object& tolerance,
-                         std::uint64_t max_steps) {
+                         std::uint64_t max_steps, const py::object& events) {
   SystemRunRequest request;
   request.integrator = integrator;
   request.control = control_from(step_control);
@@ -172,11 +233,11 @@ SystemSolution integrate(const py::object& system, const py::array_t<double, py:
   SystemSolution solution;
   if (py::isinstance<SleighSystem>(system)) {
     AutonomousChaplyginSleigh sleigh(system.cast<const SleighSystem&>().parameters);
-    solution = solve(sleigh, z0, t_span.first, t_span.second, request, nullptr);
+    solution = solve(sleigh, z0, t_span.first, t_span.second, request, nullptr, events);
   } else if (py::isinstance<UserSystem>(system)) {
     const UserSystem& user = system.cast<const UserSystem&>();
-    solution = user.dimension == 2 ? solve_user<2>(user, z0, t_span.first, t_span.second, request)
-                                   : solve_user<4>(user, z0, t_span.first, t_span.second, request);
+    solution = user.dimension == 2 ? solve_user<2>(user, z0, t_span.first, t_span.second, request, events)
+                                   : solve_user<4>(user, z0, t_span.first, t_span.second, request, events);
   } else {
     throw py::type_error("system must be a BirkhoffianSystem or a ChaplyginSleigh, got " +
                          py::repr(system).cast<std::string>());
@@ -224,8 +285,12 @@ void bind_own_system(py::module_& m) {
       .def_property_readonly("dimension", [](const SleighSystem&) { return 4; });
   py::class_<SystemSolution>(m, "SystemSolution",
                              "integrate()'s result, shaped like scipy's solve_ivp result: t (n,), y (dimension, n) "
-                             "on the member's own steps (t0 first, t1 last), nfev, njev, nsteps, nrejected, status "
-                             "(0: reached t1, -1: a step failed; y holds the states before it), message, success.")
+                             "on the member's own steps (t0 first, t1 or a terminal event last), t_events and "
+                             "y_events (per event its crossings), nfev, njev, nsteps, nrejected, status (0: reached "
+                             "t1, 1: a terminal event, -1: a step failed; y holds the states before it), message, "
+                             "success.")
+      .def_readonly("t_events", &SystemSolution::t_events)
+      .def_readonly("y_events", &SystemSolution::y_events)
       .def_readonly("t", &SystemSolution::t)
       .def_readonly("y", &SystemSolution::y)
       .def_readonly("nfev", &SystemSolution::nfev)
@@ -245,11 +310,14 @@ void bind_own_system(py::module_& m) {
   m.def("integrate", &integrate, py::arg("system"), py::arg("z0"), py::arg("t_span"),
         py::arg("integrator") = "birkhoff_gauss8", py::arg("step_size") = py::none(),
         py::arg("step_control") = "fixed", py::arg("tolerance") = py::none(), py::arg("max_steps") = 1000000,
+        py::arg("events") = py::none(),
         "Integrates a BirkhoffianSystem (or the C++ ChaplyginSleigh) from z0 at t_span[0] to t_span[1] [s] with a "
         "Birkhoffian member: at fixed steps of step_size, or under step_control 'adaptive' or 'reversible' "
         "(birkhoff_gauss4/6/8; reversible only in the identity chart) for `tolerance`, the error at t1 in the "
-        "weights max(1, |z_i|). Returns a SystemSolution. Bad requests raise ValueError naming them; an exception "
-        "raised by a callable passes through.");
+        "weights max(1, |z_i|). events: a callable g(t, z) or a list of them, with optional attributes terminal "
+        "and direction as in scipy's solve_ivp; their crossings are located on the member's own step to 1e-13 "
+        "relative. Returns a SystemSolution. Bad requests raise ValueError naming them; an exception raised by a "
+        "callable passes through.");
   m.attr("BIRKHOFFIAN_MEMBERS") = birkhoffian_member_names();
 }
 

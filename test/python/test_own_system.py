@@ -288,3 +288,70 @@ def test_a_step_that_fails_for_good_keeps_the_states_before_it():
     print(f"[ measured ] q' = q² from 1: {run.message}; last point t = {run.t[-1]:.6f} s, q = {run.y[0, -1]:.3e}")
     assert run.status == -1 and not run.success
     assert 0.9 < run.t[-1] < 1.0 and len(run.t) > 10
+
+
+# --- events ---------------------------------------------------------------------------------------
+
+def pendulum_quarter_period(q0):
+    """T/4 = K(sin(q0/2)) for q'' = -sin q from rest at q0: the complete elliptic integral of the first
+    kind by the arithmetic-geometric mean, K(k) = π / (2 AGM(1, √(1 - k²)))."""
+    a, b = 1.0, math.sqrt(1.0 - math.sin(q0 / 2) ** 2)
+    for _ in range(10):
+        a, b = (a + b) / 2, math.sqrt(a * b)
+    return math.pi / (2 * a)
+
+
+def falling_through_zero(terminal):
+    def q(t, z):
+        return z[0]
+    q.direction = -1
+    q.terminal = terminal
+    return q
+
+
+@pytest.mark.parametrize("options", [{"step_size": 0.1}, {"step_control": "adaptive", "tolerance": 1e-12},
+                                     {"step_control": "reversible", "tolerance": 1e-12}])
+def test_a_terminal_event_ends_the_pendulum_at_its_quarter_period(options):
+    exact = pendulum_quarter_period(PENDULUM_START[0])
+    run = simulator.integrate(pendulum(), PENDULUM_START, (0.0, PENDULUM_END), "birkhoff_gauss8",
+                              events=falling_through_zero(True), **options)
+    located = run.t_events[0]
+    print(f"[ measured ] pendulum q = 0 ({options}): located at {located[0]:.15f} s, exact {exact:.15f} s, "
+          f"off by {abs(located[0] - exact):.1e} s; q there {run.y_events[0][0, 0]:.1e}")
+    assert run.status == 1 and run.success and "terminal event 0" in run.message
+    assert len(located) == 1 and abs(located[0] - exact) <= 1e-10
+    assert run.t[-1] == located[0] and np.array_equal(run.y[:, -1], run.y_events[0][0])
+    assert abs(run.y_events[0][0, 0]) < 1e-12
+
+
+def test_events_that_do_not_end_the_run_find_every_crossing_in_their_direction():
+    omega = math.sqrt(STIFFNESS - GAMMA ** 2 / 4)
+    phase = math.atan2(GAMMA / 2 / omega, 1.0)  # q ∝ cos(ωt − φ) e^{−γt/2}
+    zeros = [(phase + math.pi / 2 + k * math.pi) / omega for k in range(4) if (phase + math.pi / 2 + k * math.pi) / omega < 10]
+    def q(t, z):
+        return z[0]
+    def rising(t, z):
+        return z[0]
+    rising.direction = 1
+    run = simulator.integrate(damped_oscillator_in_its_chart(), (1.0, 0.0), (0.0, 10.0), "birkhoff_gauss8",
+                              step_size=0.05, events=[q, rising])
+    print(f"[ measured ] damped oscillator q = 0: located {run.t_events[0]}, exact {np.array(zeros)}, worst "
+          f"{np.max(np.abs(run.t_events[0] - zeros)):.1e} s")
+    assert run.status == 0 and run.t[-1] == 10.0
+    assert len(zeros) == 3 and np.max(np.abs(run.t_events[0] - zeros)) <= 1e-10
+    assert np.array_equal(run.t_events[1], run.t_events[0][1::2]), "the rising crossings are every second one"
+    assert run.y_events[0].shape == (3, 2)
+
+
+@pytest.mark.parametrize("events, words", [
+    ([3.0], "events\\[0\\] must be a callable"),
+    (lambda t, z: "high", "must return a number"),
+])
+def test_bad_events_are_refused_by_name(events, words):
+    with pytest.raises(TypeError, match=words):
+        simulator.integrate(pendulum(), PENDULUM_START, (0.0, 1.0), step_size=0.1, events=events)
+
+
+def test_an_event_that_returns_nan_is_refused_by_name():
+    with pytest.raises(ValueError, match="event function returned NaN"):
+        simulator.integrate(pendulum(), PENDULUM_START, (0.0, 1.0), step_size=0.1, events=lambda t, z: float("nan"))

@@ -13,15 +13,22 @@
 //  - reversible: the reversible control (reversible_step_control.h) for the tolerance, its grid up to
 //    the last point before t₁, then one step of the member from that point to t₁ (the grid itself
 //    passes t₁; the landing step is not part of it). Needs the identity chart (an autonomous system).
+//
+// Events g(t, z) = 0 (as scipy's solve_ivp: a direction, terminal or not) are watched on every step:
+// where g changes sign over a step [tₐ, t_b], the crossing is located by the Illinois method on the
+// member's own step from (tₐ, zₐ) to τ, to |Δτ| ≤ 10⁻¹³·max(1 s, |τ|): the state there is the member's
+// state, not an interpolant's. A terminal event ends the run there (the last state is the event's).
 #pragma once
 
 #include <Eigen/Core>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <algorithm>
 #include <type_traits>
 #include <vector>
 
@@ -51,14 +58,32 @@ struct SystemRunRequest {
   std::uint64_t max_steps = 1000000;  ///< work limit: steps (accepted or not) before the run ends by name
 };
 
-/// A run's result: the states on the member's own steps, t₀ first and t₁ last.
+/// An event function g(t, z) [any unit] whose zeros are watched (scipy's solve_ivp events).
+template <class System>
+struct SystemEvent {
+  std::function<double(double, const StateVector<System, double>&)> function;
+  int direction = 0;      ///< +1: only where g rises through 0, −1: only where it falls, 0: both
+  bool terminal = false;  ///< the run ends at its first crossing
+};
+
+/// A located crossing of event `event` (its index) at `time` [s] in state `state`.
+template <class System>
+struct SystemEventCrossing {
+  std::size_t event = 0;
+  double time = 0.0;
+  StateVector<System, double> state;
+};
+
+/// A run's result: the states on the member's own steps, t₀ first and t₁ (or a terminal event) last.
 template <class System>
 struct SystemRunResult {
   std::vector<double> times;                            ///< [s]
   std::vector<StateVector<System, double>> states;      ///< z at times [the system's units]
+  std::vector<SystemEventCrossing<System>> crossings;   ///< the events' crossings, in time order
   StepStatistics statistics;                            ///< evaluations, steps, rejected attempts
-  bool finished = false;   ///< reached t₁
-  std::string message;     ///< why it stopped
+  bool finished = false;        ///< reached t₁ or a terminal event
+  bool terminal_event = false;  ///< ended at a terminal event
+  std::string message;          ///< why it stopped
 };
 
 /// A carried point of `System` at z [its units], y = 0, its angles reduced: where a run starts.
@@ -97,9 +122,108 @@ StateVector<System, double> unreduced(const Point& carried) {
   return z;
 }
 
-template <class Stepper, class System>
+/// Thrown out of a control's loop when a terminal event ends the run.
+struct TerminalEventReached {};
+
+/// Watches the events over each new step of a run and locates their crossings (file comment).
+/// `side_step(tₐ, zₐ, τ)`: the member's state at τ by one step from (tₐ, zₐ).
+template <class System, class SideStep>
+class EventWatch {
+ public:
+  using Z = StateVector<System, double>;
+  EventWatch(const std::vector<SystemEvent<System>>& events, SideStep side_step, SystemRunResult<System>& result)
+      : events_(events), side_step_(std::move(side_step)), result_(result) {
+    for (const SystemEvent<System>& event : events_) values_.push_back(value(event, result.times.back(), result.states.back()));
+  }
+
+  /// Records the step's end (t, z) in the result, after the crossings inside the step; a terminal one
+  /// replaces the end by itself and returns true.
+  bool record(double t, const Z& z) {
+    const double t_start = result_.times.back();
+    const Z z_start = result_.states.back();
+    std::vector<SystemEventCrossing<System>> found;
+    std::vector<double> values(events_.size());
+    for (std::size_t k = 0; k < events_.size(); ++k) {
+      values[k] = value(events_[k], t, z);
+      const double before = values_[k];
+      const double after = values[k];
+      const bool rises = before < 0.0 && after >= 0.0;
+      const bool falls = before > 0.0 && after <= 0.0;
+      if (!((rises && events_[k].direction >= 0) || (falls && events_[k].direction <= 0))) continue;
+      found.push_back(locate(k, t_start, z_start, before, t, z, after));
+    }
+    values_ = values;
+    std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.time < b.time; });
+    for (const SystemEventCrossing<System>& crossing : found) {
+      result_.crossings.push_back(crossing);
+      if (events_[crossing.event].terminal) {
+        result_.times.push_back(crossing.time);
+        result_.states.push_back(crossing.state);
+        result_.terminal_event = true;
+        std::ostringstream message;
+        message << "terminal event " << crossing.event << " at t = " << crossing.time << " s";
+        result_.message = message.str();
+        return true;
+      }
+    }
+    result_.times.push_back(t);
+    result_.states.push_back(z);
+    return false;
+  }
+
+ private:
+  double value(const SystemEvent<System>& event, double t, const Z& z) const {
+    const double g = event.function(t, z);
+    if (std::isnan(g)) {
+      std::ostringstream message;
+      message << "an event function returned NaN at t = " << t << " s";
+      throw std::invalid_argument(message.str());
+    }
+    return g;
+  }
+
+  /// The Illinois method (regula falsi, the stale end's value halved) on τ ∈ [tₐ, t_b].
+  SystemEventCrossing<System> locate(std::size_t k, double ta, const Z& za, double ga, double tb, const Z& zb,
+                                     double gb) {
+    SystemEventCrossing<System> crossing{k, tb, zb};
+    if (gb == 0.0) return crossing;
+    const Z start = za;
+    const double t_start = ta;
+    int stale = 0;  // +1: ta kept twice in a row, −1: tb
+    double previous = std::numeric_limits<double>::infinity();
+    for (int iteration = 0; iteration < 100; ++iteration) {
+      double tc = (ta * gb - tb * ga) / (gb - ga);
+      if (!(tc > ta && tc < tb)) tc = 0.5 * (ta + tb);
+      const Z zc = side_step_(t_start, start, tc);
+      const double gc = value(events_[k], tc, zc);
+      crossing.time = tc;
+      crossing.state = zc;
+      if (gc == 0.0 || std::abs(tc - previous) <= 1e-13 * std::max(1.0, std::abs(tc))) break;
+      previous = tc;
+      if ((gc > 0.0) == (gb > 0.0)) {
+        tb = tc;
+        gb = gc;
+        if (stale == 1) ga *= 0.5;
+        stale = 1;
+      } else {
+        ta = tc;
+        ga = gc;
+        if (stale == -1) gb *= 0.5;
+        stale = -1;
+      }
+    }
+    return crossing;
+  }
+
+  const std::vector<SystemEvent<System>>& events_;
+  SideStep side_step_;
+  SystemRunResult<System>& result_;
+  std::vector<double> values_;  ///< g of each event at the last recorded state
+};
+
+template <class Stepper, class System, class Watch>
 void run_fixed(const Stepper& stepper, System& system, double t0, double t1, const SystemRunRequest& request,
-               SystemRunResult<System>& result) {
+               SystemRunResult<System>& result, Watch& watch) {
   const double h = request.step_size;
   if (!(h > 0.0) || !std::isfinite(h)) throw std::invalid_argument("step_size must be finite and > 0 s at fixed steps");
   const double span = t1 - t0;
@@ -119,14 +243,13 @@ void run_fixed(const Stepper& stepper, System& system, double t0, double t1, con
     stepper.advance_compensated(system, point.point, point.memory, t, t_next - t, result.statistics);
     point.reduce_angles();
     ++result.statistics.internal_steps;
-    result.times.push_back(t_next);
-    result.states.push_back(unreduced<System>(point));
+    if (watch.record(t_next, unreduced<System>(point))) return;
   }
 }
 
-template <class Stepper, class System>
+template <class Stepper, class System, class Watch>
 void run_adaptive(const Stepper& stepper, System& system, double t0, double t1, const SystemRunRequest& request,
-                  SystemRunResult<System>& result) {
+                  SystemRunResult<System>& result, Watch& watch) {
   using Carried = CarriedPoint<System, typename Stepper::template Memory<System>>;
   AdaptiveStepSettings settings;
   settings.error_per_unit_step = request.tolerance / (t1 - t0);
@@ -142,40 +265,41 @@ void run_adaptive(const Stepper& stepper, System& system, double t0, double t1, 
       throw StepError(message.str());
     }
     control.step(system, t1, result.statistics);
-    result.times.push_back(control.time());
-    result.states.push_back(unreduced<System>(control.grid()));
+    if (watch.record(control.time(), unreduced<System>(control.grid()))) return;
   }
 }
 
-template <class Stepper, class System>
+template <class Stepper, class System, class Watch>
 void run_reversible(const Stepper& stepper, const System& system, double t0, double t1,
-                    const SystemRunRequest& request, SystemRunResult<System>& result) {
+                    const SystemRunRequest& request, SystemRunResult<System>& result, Watch& watch) {
   using Control = ReversibleToleranceControl<Stepper, System>;
   typename Control::Transformed transformed{system, t0};
   Control control{stepper, transformed, request.tolerance / (t1 - t0), t1 - t0};
   const auto start = seeded_point<System, NoStepMemory>(system, result.states.front());
   control.calibrate(start, t0, result.statistics);
   control.start(start, t0);
-  control.advance_past(t1, result.statistics, [&] {
-    if (result.times.size() >= request.max_steps) {
-      std::ostringstream message;
-      message << "the reversible control's grid reached max_steps = " << request.max_steps << " points before t = "
-              << t1 << " s";
-      throw StepError(message.str());
-    }
-    if (control.time() < t1) {
-      result.times.push_back(control.time());
-      result.states.push_back(unreduced<System>(control.grid()));
-    }
-  });
+  try {
+    control.advance_past(t1, result.statistics, [&] {
+      if (result.times.size() >= request.max_steps) {
+        std::ostringstream message;
+        message << "the reversible control's grid reached max_steps = " << request.max_steps
+                << " points before t = " << t1 << " s";
+        throw StepError(message.str());
+      }
+      if (control.time() < t1 && watch.record(control.time(), unreduced<System>(control.grid()))) {
+        throw TerminalEventReached{};
+      }
+    });
+  } catch (const TerminalEventReached&) {
+    return;
+  }
   // Land on t₁ with one step of the member from the last grid point before it (or on it).
   const double t_last = result.times.back();
   if (t_last < t1) {
     StateVector<System, double> z = result.states.back();
     PassiveVector<System, double> y = PassiveVector<System, double>::Zero();
     stepper.step(system, z, y, t_last, t1 - t_last, result.statistics);
-    result.times.push_back(t1);
-    result.states.push_back(z);
+    watch.record(t1, z);
   }
 }
 
@@ -233,10 +357,12 @@ inline std::vector<std::string> birkhoffian_member_names() {
 /// not finite and positive) throw std::invalid_argument naming them. A step that fails for good
 /// (StepError: a stage solve at fixed steps, the controls' work limits and step floors) ends the run
 /// with `finished` false and its message; the states before it are kept. Anything else the system's
-/// functions throw passes through.
+/// functions throw passes through. `events`: watched on every step (file comment); an event function
+/// that returns NaN is std::invalid_argument.
 template <class System>
 SystemRunResult<System> integrate_system(System& system, const StateVector<System, double>& z0, double t0, double t1,
-                                         const SystemRunRequest& request) {
+                                         const SystemRunRequest& request,
+                                         const std::vector<SystemEvent<System>>& events = {}) {
   if (!std::isfinite(t0) || !std::isfinite(t1) || !(t1 > t0)) {
     throw std::invalid_argument("the time span needs finite t0 < t1 [s]");
   }
@@ -266,8 +392,6 @@ SystemRunResult<System> integrate_system(System& system, const StateVector<Syste
     }
   }
   SystemRunResult<System> result;
-  result.times.push_back(t0);
-  result.states.push_back(z0);
   std::apply(
       [&](const auto&... member) {
         (
@@ -276,22 +400,34 @@ SystemRunResult<System> integrate_system(System& system, const StateVector<Syste
               if constexpr (is_birkhoffian(member_kind<Stepper>())) {
                 if (request.integrator != Stepper::name()) return;
                 const Stepper stepper = configured_stepper<Stepper>(IntegratorSettings{});
+                // The member's state at τ by one step from (tₐ, zₐ): where the events are located.
+                auto side_step = [&](double ta, const StateVector<System, double>& za, double tau) {
+                  StateVector<System, double> z = za;
+                  PassiveVector<System, double> y = PassiveVector<System, double>::Zero();
+                  stepper.step(system, z, y, ta, tau - ta, result.statistics);
+                  return z;
+                };
+                result.times.clear();
+                result.states.clear();
+                result.times.push_back(t0);
+                result.states.push_back(z0);
+                system_integration_detail::EventWatch<System, decltype(side_step)> watch(events, side_step, result);
                 try {
                   if (request.control == SystemStepControl::kFixed) {
-                    system_integration_detail::run_fixed(stepper, system, t0, t1, request, result);
+                    system_integration_detail::run_fixed(stepper, system, t0, t1, request, result, watch);
                   }
                   if constexpr (system_integration_detail::kIsGaussMember<Stepper>) {
                     if (request.control == SystemStepControl::kAdaptive) {
-                      system_integration_detail::run_adaptive(stepper, system, t0, t1, request, result);
+                      system_integration_detail::run_adaptive(stepper, system, t0, t1, request, result, watch);
                     }
                     if constexpr (system_traits::kDarbouxChartIsIdentity<System>) {
                       if (request.control == SystemStepControl::kReversible) {
-                        system_integration_detail::run_reversible(stepper, system, t0, t1, request, result);
+                        system_integration_detail::run_reversible(stepper, system, t0, t1, request, result, watch);
                       }
                     }
                   }
                   result.finished = true;
-                  result.message = "the run reached t1";
+                  if (!result.terminal_event) result.message = "the run reached t1";
                 } catch (const StepError& error) {
                   result.finished = false;
                   result.message = error.what();
