@@ -12,7 +12,8 @@
 //    oscillator of docs/python.md over 100 s, whose phase error grows along the run;
 //  - reversible: the reversible control (reversible_step_control.h) for the tolerance, its grid up to
 //    the last point before t₁, then one step of the member from that point to t₁ (the grid itself
-//    passes t₁; the landing step is not part of it). Needs the identity chart (an autonomous system).
+//    passes t₁; the landing step is not part of it). Every Birkhoffian member (all symmetric); needs
+//    the identity chart (time enters the time transformation as a passive coordinate).
 //
 // Events g(t, z) = 0 (as scipy's solve_ivp: a direction, terminal or not) are watched on every step:
 // where g changes sign over a step [tₐ, t_b], the crossing is located by the Illinois method on the
@@ -308,8 +309,8 @@ void run_reversible(const Stepper& stepper, const System& system, double t0, dou
 /// Is `name` a Birkhoffian member, and which controls does it take here?
 struct SystemMemberInfo {
   bool found = false;
-  bool adaptive = false;    ///< the Gauss members with two stages or more
-  bool reversible = false;  ///< the same, where the system's chart is the identity
+  bool adaptive = false;    ///< the Gauss members with two stages or more (the registry's)
+  bool reversible = false;  ///< every (symmetric) Birkhoffian member, where the system's chart is the identity
 };
 
 template <class System>
@@ -323,10 +324,8 @@ SystemMemberInfo system_member_info(const std::string& name) {
               if constexpr (is_birkhoffian(member_kind<Stepper>())) {
                 if (name == Stepper::name()) {
                   info.found = true;
-                  if constexpr (system_integration_detail::kIsGaussMember<Stepper>) {
-                    info.adaptive = true;
-                    info.reversible = system_traits::kDarbouxChartIsIdentity<System>;
-                  }
+                  info.adaptive = system_integration_detail::kIsGaussMember<Stepper>;
+                  info.reversible = Stepper::kSymmetric && system_traits::kDarbouxChartIsIdentity<System>;
                 }
               }
             }(member),
@@ -381,13 +380,14 @@ SystemRunResult<System> integrate_system(System& system, const StateVector<Syste
     const bool taken = request.control == SystemStepControl::kAdaptive ? info.adaptive : info.reversible;
     if (!taken) {
       std::ostringstream message;
-      message << "step control '" << (request.control == SystemStepControl::kAdaptive ? "adaptive" : "reversible")
-              << "' is not for '" << request.integrator << "' on this system: it takes birkhoff_gauss4, "
-              << "birkhoff_gauss6 and birkhoff_gauss8"
-              << (request.control == SystemStepControl::kReversible ? ", and only without a Darboux chart of "
-                                                                       "its own (the identity chart)"
-                                                                     : "")
-              << "; run it at fixed steps";
+      if (request.control == SystemStepControl::kAdaptive) {
+        message << "step control 'adaptive' is not for '" << request.integrator
+                << "': it takes birkhoff_gauss4, birkhoff_gauss6 and birkhoff_gauss8 (the others' estimates do "
+                   "not follow their error: docs/accuracy.md §4.4); run it at fixed steps";
+      } else {
+        message << "step control 'reversible' is not for this system: it needs the identity chart (a system "
+                   "without a Darboux chart of its own); run it at fixed steps or under the adaptive control";
+      }
       throw std::invalid_argument(message.str());
     }
   }
@@ -420,10 +420,10 @@ SystemRunResult<System> integrate_system(System& system, const StateVector<Syste
                     if (request.control == SystemStepControl::kAdaptive) {
                       system_integration_detail::run_adaptive(stepper, system, t0, t1, request, result, watch);
                     }
-                    if constexpr (system_traits::kDarbouxChartIsIdentity<System>) {
-                      if (request.control == SystemStepControl::kReversible) {
-                        system_integration_detail::run_reversible(stepper, system, t0, t1, request, result, watch);
-                      }
+                  }
+                  if constexpr (Stepper::kSymmetric && system_traits::kDarbouxChartIsIdentity<System>) {
+                    if (request.control == SystemStepControl::kReversible) {
+                      system_integration_detail::run_reversible(stepper, system, t0, t1, request, result, watch);
                     }
                   }
                   result.finished = true;
