@@ -42,6 +42,11 @@ class CartStepper {
   /// internal steps; nothing for the fixed-step members, whose steps are the caller's own).
   using GridObserver = std::function<void(const CartState& grid_state)>;
   virtual void observe_grid(GridObserver /*observer*/) {}
+  /// The state at `time` [s] within the member's newest accepted own step, from its dense output,
+  /// the run unmoved (event location: docs/python.md "Events"; a grid observer may call it for the
+  /// step it is told of). False when there is none there: `time` outside the newest step, no step of
+  /// the current grid yet (its start, a restart at an actuator's kink), a member at fixed steps.
+  virtual bool newest_step_state(double /*time*/, CartState& /*out*/) { return false; }
 };
 
 /// Makes the registry's member settings.name (integrator_registry.h) for `model` and `effects`

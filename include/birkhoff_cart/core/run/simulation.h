@@ -101,6 +101,10 @@ class Simulation {
   /// `observer` is called with the state after every accepted step of a step control's own grid
   /// (not for fixed-step members). Kept across reset() and restart_from(); an empty function stops it.
   void observe_grid(CartStepper::GridObserver observer);
+  /// For a member with its own steps: the state at `time` [s] within its newest accepted own step,
+  /// from its dense output, without moving the run (CartStepper::newest_step_state; a grid observer
+  /// may call it for the step it is told of: event location). False when there is none there.
+  bool newest_step_state(double time, CartState& out) const { return stepper_->newest_step_state(time, out); }
 
   /// An instant [s] a step control's own steps must end on exactly instead of interpolating there
   /// (CartStepper::land_on; the run's end always is one). For the current run only: reset() and
