@@ -237,3 +237,39 @@ def test_the_reversible_control_whose_last_step_passes_the_end_gives_the_same_re
     print(f"{member} reversible: {result.nsteps} own steps, heading = 1 rad at {fine.t_events[0][0]:.12f} s, "
           f"{difference:.1e} s from dopri5 at 1e-14")
     assert 3.5 < fine.t_events[0][0] < 4.5 and difference <= 1e-10
+
+
+def test_threads_each_solving_finish_as_one_thread_does():
+    # solve() holds the GIL only for event functions: four threads, two with events and two
+    # without, each end in the one-thread result; in a child with a timeout, so a hang fails.
+    from test_simulator_hostile import run_child
+    out = run_child("""
+        import threading
+        import numpy as np
+        from birkhoff_cart import simulator
+        F = {name: k for k, name in enumerate(simulator.STATE_FIELDS)}
+        scene = simulator.load_scene("config/scenes/sine_steer_torque.yaml", {
+            "reference": None, "duration": 4.0,
+            "integrator": {"name": "birkhoff_gauss6", "step_control": "adaptive",
+                           "position_tolerance": 1e-9, "step_size": 0.05}})
+        def crossing(t, s):
+            return s[F["chi"]]
+        def work(k):
+            result = simulator.solve(scene, events=crossing if k % 2 else None, dense_output=True)
+            return result.y_steps, result.t_events, result.sol(np.linspace(0.0, 4.0, 9))
+        expected = [work(0), work(1)]
+        results = [None] * 4
+        def run(k):
+            results[k] = work(k)
+        for attempt in range(3):
+            threads = [threading.Thread(target=run, args=(k,), daemon=True) for k in range(4)]
+            for t in threads: t.start()
+            for t in threads: t.join()
+            for k, (steps, events, dense) in enumerate(results):
+                want = expected[k % 2]
+                assert np.array_equal(steps, want[0]) and np.array_equal(dense, want[2])
+                assert (events is None) == (want[1] is None)
+                assert events is None or np.array_equal(events[0], want[1][0])
+        print("ok", expected[1][1][0].size)
+        """)
+    assert out.startswith("ok") and int(out.split()[1]) >= 2
