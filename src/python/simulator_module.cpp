@@ -6,8 +6,9 @@
 // call pays the crossing once; calls on one Simulation from several threads take its lock one at a
 // time, waiting for it without the GIL. solve() runs a scene whole and returns it shaped like
 // scipy's solve_ivp result: its own steps, t_eval's states and the events' crossings read on the way
-// from the member's dense output (Simulation::newest_step_state, located by crossing.h); only the
-// event functions are called with the GIL held. docs/python.md.
+// from the member's dense output (Simulation::newest_step_state; at fixed steps one step of the
+// member beside the run, Simulation::state_by_one_step), located by crossing.h; only the event
+// functions are called with the GIL held. docs/python.md.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -401,23 +402,27 @@ void require_t_eval(const std::vector<double>& t_eval, double t0, double end) {
 /// depend on t_eval or the events, and a run again with other t_eval (sol) is the same run. A t_eval
 /// instant in a step without dense output (one that ends at an actuator's kink, where the grid
 /// restarts) is taken after the run by a run of its own to it (its dense output there). A member at
-/// fixed steps records the schedule's steps; t_eval then takes the schedule's instants, by a run of
-/// its own (GuardedRun::states_at). Event functions are called with the GIL held.
-DrivenRun drive(const Scene& scene, const std::vector<double>& t_eval, bool with_t_eval,
-                std::vector<EventFunction>& events, double event_tolerance) {
+/// fixed steps records the schedule's steps; its crossings are located on states reached by one
+/// step of the member from the step's start (Simulation::state_by_one_step); t_eval takes the
+/// schedule's instants, by a run of its own (GuardedRun::states_at). Event functions are called
+/// with the GIL held.
+DrivenRun drive(const Scene& scene, const std::vector<double>& t_eval, std::vector<EventFunction>& events,
+                double event_tolerance) {
   DrivenRun run;
   Simulation simulation(scene);
   run.integrator = simulation.integrator_name();
   const bool own_steps = simulation.takes_own_steps();
-  if (!events.empty() && !own_steps) {
-    throw py::value_error("events need a dense output between steps: " + simulation.integrator_name() +
-                          " steps at fixed steps; take a step control (integrator.step_control: adaptive or "
-                          "reversible) or dopri5");
-  }
   const double t0 = simulation.state().time;  // [s]
   const double end = simulation.end_time();    // [s]
   require_t_eval(t_eval, t0, end);
   if (!own_steps) require_recordable(simulation.schedule().total_steps() + 1, "solve()'s steps");
+  if (!own_steps && !events.empty()) {
+    try {  // refused here, by the core's reason, rather than at the first crossing
+      simulation.state_by_one_step(simulation.state(), t0 + 0.5 * simulation.step_size());
+    } catch (const std::logic_error& error) {
+      throw py::value_error(std::string("events at fixed steps: ") + error.what());
+    }
+  }
 
   std::vector<CartState>& steps = run.steps;
   std::vector<CartState>& outputs = run.outputs;
@@ -429,6 +434,68 @@ DrivenRun drive(const Scene& scene, const std::vector<double>& t_eval, bool with
   std::vector<double> g_now;
   for (const EventFunction& function : events) g_now.push_back(event_value(function, simulation.state()));
   CartState stop_state;
+  double stop_time = std::numeric_limits<double>::infinity();  // [s]
+
+  // The state at t inside the step from `before` (false: none there): the dense output of a member
+  // with its own steps, one step of the member from the step's start at fixed steps.
+  const auto state_in_step = [&](const CartState& before, double t, CartState& out) {
+    if (own_steps) return simulation.newest_step_state(t, out);
+    out = simulation.state_by_one_step(before, t);
+    return true;
+  };
+
+  // The crossings of the step from `before` to `after`, in time order, up to a terminal one (then
+  // true, with stop_time and stop_state set).
+  const auto crossings_in_step = [&](const CartState& before, const CartState& after) {
+    struct Found {
+      double time;  // [s]
+      std::size_t event;
+      CartState state;
+    };
+    std::vector<Found> found;
+    std::vector<double> g_next(events.size());
+    for (std::size_t i = 0; i < events.size(); ++i) {
+      g_next[i] = event_value(events[i], after);
+      if (!triggers(events[i], g_now[i], g_next[i])) continue;
+      if (g_now[i] == 0.0 && steps.size() == 1) continue;  // zero at the start: no crossing
+      CartState at = after;
+      double time = after.time;  // [s]
+      if (state_in_step(before, 0.5 * (before.time + after.time), at)) {
+        const auto g_at = [&](double t) {
+          CartState probe;
+          state_in_step(before, t, probe);
+          return event_value(events[i], probe);
+        };
+        time = locate_crossing(g_at, before.time, g_now[i], after.time, g_next[i], event_tolerance).time;
+        if (time == after.time) {
+          at = after;
+        } else if (time == before.time) {
+          at = before;
+        } else {
+          state_in_step(before, time, at);
+        }
+      } else {
+        // No dense output on this step (a grid restarted at an actuator's kink): the step's end,
+        // where g has reached zero or passed it, so that no crossing is reported early.
+        at = after;
+      }
+      found.push_back({time, i, at});
+    }
+    g_now = g_next;
+    std::stable_sort(found.begin(), found.end(), [](const Found& a, const Found& b) { return a.time < b.time; });
+    for (const Found& event : found) {
+      EventFunction& function = events[event.event];
+      function.times.push_back(event.time);
+      function.states.push_back(event.state);
+      if (function.terminal_after > 0 && function.times.size() >= function.terminal_after) {
+        stop_time = event.time;
+        stop_state = event.state;
+        run.stopping_event = event.event;
+        return true;
+      }
+    }
+    return false;
+  };
 
   // Each own step: its crossings, then t_eval's instants in it up to a terminal crossing.
   const auto on_step = [&](const CartState& stepped_to) {
@@ -439,59 +506,7 @@ DrivenRun drive(const Scene& scene, const std::vector<double>& t_eval, bool with
     CartState clipped;
     if (beyond_end && !simulation.newest_step_state(end, clipped)) return;
     const CartState& grid_state = beyond_end ? clipped : stepped_to;
-    const CartState& before = steps.back();
-    double stop_time = std::numeric_limits<double>::infinity();  // [s]
-    bool stop = false;
-    if (!events.empty()) {
-      struct Found {
-        double time;  // [s]
-        std::size_t event;
-        CartState state;
-      };
-      std::vector<Found> found;
-      std::vector<double> g_next(events.size());
-      for (std::size_t i = 0; i < events.size(); ++i) {
-        g_next[i] = event_value(events[i], grid_state);
-        if (!triggers(events[i], g_now[i], g_next[i])) continue;
-        if (g_now[i] == 0.0 && steps.size() == 1) continue;  // zero at the start: no crossing
-        CartState at;
-        double time = grid_state.time;  // [s]
-        if (simulation.newest_step_state(0.5 * (before.time + grid_state.time), at)) {
-          const auto g_at = [&](double t) {
-            CartState probe;
-            simulation.newest_step_state(t, probe);
-            return event_value(events[i], probe);
-          };
-          time = locate_crossing(g_at, before.time, g_now[i], grid_state.time, g_next[i], event_tolerance).time;
-          if (time == grid_state.time) {
-            at = grid_state;
-          } else if (time == before.time) {
-            at = before;
-          } else {
-            simulation.newest_step_state(time, at);
-          }
-        } else {
-          // No dense output on this step (a grid restarted at an actuator's kink): the step's end,
-          // where g has reached zero or passed it, so that no crossing is reported early.
-          at = grid_state;
-        }
-        found.push_back({time, i, at});
-      }
-      std::stable_sort(found.begin(), found.end(), [](const Found& a, const Found& b) { return a.time < b.time; });
-      for (const Found& event : found) {
-        EventFunction& function = events[event.event];
-        function.times.push_back(event.time);
-        function.states.push_back(event.state);
-        if (function.terminal_after > 0 && function.times.size() >= function.terminal_after) {
-          stop = true;
-          stop_time = event.time;
-          stop_state = event.state;
-          run.stopping_event = event.event;
-          break;
-        }
-      }
-      g_now = g_next;
-    }
+    const bool stop = !events.empty() && crossings_in_step(steps.back(), grid_state);
     const double reach = std::min(grid_state.time, stop_time);  // [s]
     for (; next_output < t_eval.size() && t_eval[next_output] <= reach && t_eval[next_output] < end; ++next_output) {
       const double t = t_eval[next_output];
@@ -538,13 +553,34 @@ DrivenRun drive(const Scene& scene, const std::vector<double>& t_eval, bool with
         for (std::size_t k = 0; k < states.size(); ++k) outputs[deferred_at[k]] = states[k];
       }
     } else {
-      while (!simulation.at_end()) {
-        simulation.step_on_schedule();
-        steps.push_back(simulation.state());
+      try {
+        while (!simulation.at_end()) {
+          simulation.step_on_schedule();
+          if (!events.empty() && crossings_in_step(steps.back(), simulation.state())) {
+            run.status = 1;
+            run.message = "A termination event occurred.";
+            steps.push_back(stop_state);
+            break;
+          }
+          steps.push_back(simulation.state());
+        }
+      } catch (const StepError& error) {
+        run.status = -1;
+        run.message = error.what();
       }
-      if (with_t_eval) {  // the schedule's instants, by the run loop's own rule (a run of its own)
+      // t_eval: the schedule's instants the run reached, by the run loop's own rule (a run of its
+      // own, which refuses an instant off the schedule by name); the crossing's own instant.
+      const double reached = run.status == 1 ? stop_time : steps.back().time;  // [s]
+      std::vector<double> on_schedule;
+      for (double t : t_eval) {
+        if (t < reached || (t == reached && run.status != 1)) on_schedule.push_back(t);
+      }
+      if (!on_schedule.empty()) {
         GuardedRun again(scene);
-        outputs = again.states_at(t_eval);
+        outputs = again.states_at(on_schedule);
+      }
+      if (run.status == 1 && outputs.size() < t_eval.size() && t_eval[outputs.size()] == stop_time) {
+        outputs.push_back(stop_state);
       }
     }
   } catch (const StepError& error) {
@@ -576,7 +612,7 @@ py::object solve(const Scene& scene, const py::object& t_eval_given, bool dense_
     t_eval = times_of(t_eval_given, "t_eval");
     require_recordable(t_eval.size(), "solve(t_eval of " + std::to_string(t_eval.size()) + " times)");
   }
-  const DrivenRun run = drive(scene, t_eval, with_t_eval, events, event_tolerance);
+  const DrivenRun run = drive(scene, t_eval, events, event_tolerance);
   const std::vector<CartState>& shown = with_t_eval ? run.outputs : run.steps;
   py::object result = py::cast(SolveResult{});
   const py::object y = states_array(shown).attr("T").attr("copy")();  // STATE_FIELDS × times
@@ -625,7 +661,7 @@ py::object dense_states(const DenseSolution& dense, const py::object& t) {
   std::sort(sorted.begin(), sorted.end());
   sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
   std::vector<EventFunction> none;
-  const DrivenRun run = drive(dense.scene, sorted, true, none, kDefaultEventTolerance);
+  const DrivenRun run = drive(dense.scene, sorted, none, kDefaultEventTolerance);
   if (run.outputs.size() < sorted.size()) {  // the run failed before the last instant asked
     throw py::value_error("sol(t): the run again ended before t = " + std::to_string(sorted[run.outputs.size()]) +
                           " s: " + run.message);
@@ -732,8 +768,8 @@ PYBIND11_MODULE(simulator, m) {
         py::arg("events") = py::none(), py::arg("event_tolerance") = kDefaultEventTolerance,
         "The scene's whole run from its start, returned like scipy's solve_ivp: t, y (STATE_FIELDS x times), "
         "t_steps and y_steps (the member's own steps), sol (dense_output=True), t_events and y_events (events: "
-        "callables g(t, state) with .terminal and .direction, located on the dense output to event_tolerance "
-        "[s]), nfev, njev, nlu, nsteps, status, message, success, statistics. docs/python.md.");
+        "callables g(t, state) with .terminal and .direction, located on the dense output, or at fixed steps on "
+        "one step of the member, to event_tolerance [s]), nfev, njev, nlu, nsteps, status, message, success, statistics. docs/python.md.");
 
   py::class_<SharedRun>(m, "Simulation",
                         "A running scene with its accuracy guard, checked where cart_simulate checks it: at the "

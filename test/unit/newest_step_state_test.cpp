@@ -3,10 +3,11 @@
 // plain regula falsi stalls; and Simulation::newest_step_state reads a member's dense output on its
 // newest own step without moving the run: exactly the grid point at the step's end, the state the
 // run itself hands out at an instant inside the step, nothing outside it, and nothing for a member
-// at fixed steps.
+// at fixed steps; and Simulation::state_by_one_step, a fixed-step member's step beside the run.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -125,6 +126,40 @@ TEST(NewestStepStateAtFixedSteps, IsNone) {
   simulation.step();
   CartState at;
   EXPECT_FALSE(simulation.newest_step_state(simulation.state().time - 0.5 * scene.integrator.step_size, at));
+}
+
+TEST(StateByOneStep, IsTheMembersStepBesideTheRunWhichItLeavesAsItWas) {
+  for (const std::string member : {"birkhoff_gauss8", "rk4", "birkhoff2"}) {
+    Scene scene = load_scene(scene_path("sine_steer_torque"));
+    scene.duration = 1.0;
+    scene.reference = ReferenceSettings{};
+    scene.integrator.name = member;
+    scene.integrator.step_size = 0.01;
+    Simulation simulation(scene);
+    Simulation untouched(scene);
+    for (int k = 0; k < 40; ++k) {
+      const CartState before = simulation.state();
+      const CartState middle = simulation.state_by_one_step(before, before.time + 0.004);
+      const CartState whole = simulation.state_by_one_step(before, before.time + 0.01);
+      EXPECT_EQ(middle.time, before.time + 0.004);
+      EXPECT_GT(std::hypot(middle.x - before.x, middle.y - before.y), 0.0);
+      simulation.step();
+      untouched.step();
+      // One step of h from the run's state is the run's step, to round-off (a collocation member
+      // starts it afresh from p = M(χ) ω instead of its carried point).
+      EXPECT_NEAR(whole.x, simulation.state().x, 1e-12) << member;
+      EXPECT_NEAR(whole.forward_speed, simulation.state().forward_speed, 1e-12) << member;
+      EXPECT_EQ(simulation.state().x, untouched.state().x) << member;  // the run unmoved
+    }
+    EXPECT_EQ(simulation.statistics().rhs_evaluations, untouched.statistics().rhs_evaluations);
+    EXPECT_THROW(simulation.state_by_one_step(simulation.state(), simulation.state().time + 0.02),
+                 std::invalid_argument);
+    EXPECT_THROW(simulation.state_by_one_step(simulation.state(), simulation.state().time), std::invalid_argument);
+  }
+  Simulation own(own_steps("birkhoff_gauss6"));
+  EXPECT_THROW(own.state_by_one_step(own.state(), own.state().time + 0.01), std::logic_error);
+  Simulation actuated(load_scene(scene_path("steering_actuator")));
+  EXPECT_THROW(actuated.state_by_one_step(actuated.state(), actuated.state().time + 0.001), std::logic_error);
 }
 
 }  // namespace

@@ -105,6 +105,14 @@ class Simulation {
   /// from its dense output, without moving the run (CartStepper::newest_step_state; a grid observer
   /// may call it for the step it is told of: event location). False when there is none there.
   bool newest_step_state(double time, CartState& out) const { return stepper_->newest_step_state(time, out); }
+  /// For a member at fixed steps: the state at `time` [s] reached by one step of the member from
+  /// `from` (a state of this run, from.time < time ≤ from.time + h), by a stepper of its own: the
+  /// state between two steps to the member's order, the run, its stepper's memory and its counters
+  /// unmoved (event location at fixed steps). Throws std::logic_error for a member with its own
+  /// steps (newest_step_state reads their dense output) and for a scene with actuators or end
+  /// stops (their state moves with the run's steps); std::invalid_argument for a time outside
+  /// (from.time, from.time + (1 + 2·kMinFinalStepFraction) h]; StepError as a step.
+  CartState state_by_one_step(const CartState& from, double time) const;
 
   /// An instant [s] a step control's own steps must end on exactly instead of interpolating there
   /// (CartStepper::land_on; the run's end always is one). For the current run only: reset() and
@@ -167,6 +175,7 @@ class Simulation {
   bool finished_off_grid_ = false;  ///< step_to() left the grid t₀ + n h
   bool controlled_off_grid_ = false;  ///< advance_output_to() left the grid t₀ + n h
   CartStepper::GridObserver grid_observer_;
+  mutable std::unique_ptr<CartStepper> one_step_stepper_;  ///< state_by_one_step's own, made when first asked
   bool endless_ = false;            ///< plan_run(+inf): no end, schedule_ unused
   StepStatistics statistics_;
   double initial_energy_ = 0.0;
