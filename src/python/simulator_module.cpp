@@ -377,6 +377,7 @@ struct DrivenRun {
   std::string message = "The solver successfully reached the end of the integration interval.";
   std::size_t stopping_event = 0;
   StepStatistics statistics;
+  StepStatistics reading;  ///< the work of reading t_eval and the crossings beside the run (dense output, one steps)
   std::string integrator;
 };
 
@@ -415,7 +416,13 @@ DrivenRun drive(const Scene& scene, const std::vector<double>& t_eval, std::vect
   const double t0 = simulation.state().time;  // [s]
   const double end = simulation.end_time();    // [s]
   require_t_eval(t_eval, t0, end);
-  if (!own_steps) require_recordable(simulation.schedule().total_steps() + 1, "solve()'s steps");
+  std::vector<std::uint64_t> t_eval_steps;  // at fixed steps: the step count of each t_eval instant
+  if (!own_steps) {
+    require_recordable(simulation.schedule().total_steps() + 1, "solve()'s steps");
+    for (double t : t_eval) {
+      t_eval_steps.push_back(schedule_step_at(simulation.schedule(), t, simulation.integrator_name()));
+    }
+  }
   if (!own_steps && !events.empty()) {
     try {  // refused here, by the core's reason, rather than at the first crossing
       simulation.state_by_one_step(simulation.state(), t0 + 0.5 * simulation.step_size());
@@ -430,7 +437,9 @@ DrivenRun drive(const Scene& scene, const std::vector<double>& t_eval, std::vect
   std::size_t next_output = 0;  // the next t_eval entry to output
   std::vector<double> deferred;  // t_eval entries without dense output where they fell
   std::vector<std::size_t> deferred_at;  // their places in outputs
-  for (; next_output < t_eval.size() && t_eval[next_output] == t0; ++next_output) outputs.push_back(steps.front());
+  for (; own_steps && next_output < t_eval.size() && t_eval[next_output] == t0; ++next_output) {
+    outputs.push_back(steps.front());
+  }
   std::vector<double> g_now;
   for (const EventFunction& function : events) g_now.push_back(event_value(function, simulation.state()));
   CartState stop_state;
@@ -439,8 +448,8 @@ DrivenRun drive(const Scene& scene, const std::vector<double>& t_eval, std::vect
   // The state at t inside the step from `before` (false: none there): the dense output of a member
   // with its own steps, one step of the member from the step's start at fixed steps.
   const auto state_in_step = [&](const CartState& before, double t, CartState& out) {
-    if (own_steps) return simulation.newest_step_state(t, out);
-    out = simulation.state_by_one_step(before, t);
+    if (own_steps) return simulation.newest_step_state(t, out, &run.reading);
+    out = simulation.state_by_one_step(before, t, &run.reading);
     return true;
   };
 
@@ -504,7 +513,7 @@ DrivenRun drive(const Scene& scene, const std::vector<double>& t_eval, std::vect
     // by a side step to the end) is read up to the end only, and not kept as an own step.
     const bool beyond_end = stepped_to.time > end;
     CartState clipped;
-    if (beyond_end && !simulation.newest_step_state(end, clipped)) return;
+    if (beyond_end && !simulation.newest_step_state(end, clipped, &run.reading)) return;
     const CartState& grid_state = beyond_end ? clipped : stepped_to;
     const bool stop = !events.empty() && crossings_in_step(steps.back(), grid_state);
     const double reach = std::min(grid_state.time, stop_time);  // [s]
@@ -513,7 +522,7 @@ DrivenRun drive(const Scene& scene, const std::vector<double>& t_eval, std::vect
       CartState at = grid_state;
       if (stop && t == stop_time) {
         at = stop_state;
-      } else if (t != grid_state.time && !simulation.newest_step_state(t, at)) {
+      } else if (t != grid_state.time && !simulation.newest_step_state(t, at, &run.reading)) {
         deferred.push_back(t);
         deferred_at.push_back(outputs.size());
       }
@@ -551,6 +560,7 @@ DrivenRun drive(const Scene& scene, const std::vector<double>& t_eval, std::vect
         GuardedRun again(scene);
         const std::vector<CartState> states = again.states_at(deferred);
         for (std::size_t k = 0; k < states.size(); ++k) outputs[deferred_at[k]] = states[k];
+        run.reading.rhs_evaluations += again.simulation().statistics().rhs_evaluations;
       }
     } else {
       try {
@@ -568,19 +578,16 @@ DrivenRun drive(const Scene& scene, const std::vector<double>& t_eval, std::vect
         run.status = -1;
         run.message = error.what();
       }
-      // t_eval: the schedule's instants the run reached, by the run loop's own rule (a run of its
-      // own, which refuses an instant off the schedule by name); the crossing's own instant.
-      const double reached = run.status == 1 ? stop_time : steps.back().time;  // [s]
-      std::vector<double> on_schedule;
-      for (double t : t_eval) {
-        if (t < reached || (t == reached && run.status != 1)) on_schedule.push_back(t);
-      }
-      if (!on_schedule.empty()) {
-        GuardedRun again(scene);
-        outputs = again.states_at(on_schedule);
-      }
-      if (run.status == 1 && outputs.size() < t_eval.size() && t_eval[outputs.size()] == stop_time) {
-        outputs.push_back(stop_state);
+      // t_eval: the schedule's steps the run reached (before a crossing that stopped it), and the
+      // crossing's own instant.
+      const std::size_t scheduled = run.status == 1 ? steps.size() - 1 : steps.size();  // steps[n]: after n steps
+      for (std::size_t j = 0; j < t_eval.size(); ++j) {
+        if (t_eval_steps[j] < scheduled && !(t_eval[j] > stop_time)) {
+          outputs.push_back(steps[t_eval_steps[j]]);
+        } else {
+          if (run.status == 1 && t_eval[j] == stop_time) outputs.push_back(stop_state);
+          break;
+        }
       }
     }
   } catch (const StepError& error) {
@@ -630,7 +637,7 @@ py::object solve(const Scene& scene, const py::object& t_eval_given, bool dense_
   }
   result.attr("t_events") = events.empty() ? py::object(py::none()) : py::object(t_events);
   result.attr("y_events") = events.empty() ? py::object(py::none()) : py::object(y_events);
-  result.attr("nfev") = run.statistics.rhs_evaluations;
+  result.attr("nfev") = run.statistics.rhs_evaluations + run.reading.rhs_evaluations;
   result.attr("njev") = py::none();  // no count kept: statistics["newton_iterations"] is the implicit members' work
   result.attr("nlu") = py::none();
   result.attr("nsteps") = run.steps.size() - 1;

@@ -287,6 +287,12 @@ def test_at_fixed_steps_a_crossing_is_located_on_one_step_of_the_member_from_the
     print(f"birkhoff_gauss8 at h = 0.05 s: {difference:.1e} s from dopri5 at 1e-14")
     assert difference <= 1e-10
     assert abs(fixed.y_events[0][0, FIELD["y"]] - 2.0) < 1e-12
+    # nfev counts the steps beside the run that located it; the run's own counts are the same as
+    # without the event, and t_eval at fixed steps costs nothing (the schedule's states).
+    plain = simulator.solve(sine({"name": "birkhoff_gauss8", "step_size": 0.05}), t_eval=[0.0, 3.0, 6.0])
+    assert plain.nfev == plain.statistics["rhs_evaluations"]
+    assert fixed.statistics["rhs_evaluations"] == plain.statistics["rhs_evaluations"] < fixed.nfev
+    assert np.array_equal(plain.y, fixed.y_steps[:, [0, 60, 120]])
     # Terminal: the run and t_eval end at the crossing, which lies between two steps.
     y_passes.terminal = True
     t_eval = np.arange(0.0, 6.0001, 0.05)

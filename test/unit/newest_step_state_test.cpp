@@ -72,6 +72,7 @@ TEST_P(NewestStepState, IsTheGridPointAtTheStepsEndAndTheRunsOwnOutputInside) {
   Simulation outputs(scene);  // the same run, asked for the instants newest_step_state was asked for
   std::vector<double> middles;
   std::vector<CartState> read;
+  StepStatistics reading;  // the work of the readings, apart from the run's
   double previous = scene.initial_state.time;
   int outside_refused = 0;
   simulation.observe_grid([&](const CartState& grid) {
@@ -83,7 +84,7 @@ TEST_P(NewestStepState, IsTheGridPointAtTheStepsEndAndTheRunsOwnOutputInside) {
       EXPECT_EQ(at.forward_speed, grid.forward_speed);
     }
     const double middle = previous + 0.37 * (std::min(grid.time, simulation.end_time()) - previous);
-    ASSERT_TRUE(simulation.newest_step_state(middle, at));
+    ASSERT_TRUE(simulation.newest_step_state(middle, at, &reading));
     EXPECT_EQ(at.time, middle);
     middles.push_back(middle);
     read.push_back(at);
@@ -106,6 +107,10 @@ TEST_P(NewestStepState, IsTheGridPointAtTheStepsEndAndTheRunsOwnOutputInside) {
   EXPECT_EQ(simulation.state().x, untouched.state().x);
   EXPECT_EQ(simulation.state().y, untouched.state().y);
   EXPECT_EQ(simulation.state().heading, untouched.state().heading);
+  // Its counters too: what the readings evaluate (the rates of held points the Hermite interpolant
+  // lacks; here every grid point brings its own) is counted apart.
+  EXPECT_EQ(simulation.statistics().rhs_evaluations, untouched.statistics().rhs_evaluations);
+  EXPECT_EQ(reading.rhs_evaluations, 0u);
   // Inside a step: what the run hands out at that instant (its dense output), to the last digits.
   double worst = 0.0;  // [m]
   for (std::size_t k = 0; k < middles.size(); ++k) {

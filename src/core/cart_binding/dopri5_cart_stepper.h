@@ -51,7 +51,7 @@ class Dopri5RunCartStepper final : public CartStepper {
   void land_on(double time) override { instants_.land_on(time); }
   void observe_grid(GridObserver observer) override { observer_ = std::move(observer); }
   /// odeint's dense output on the newest accepted step (its continuous extension), the run unmoved.
-  bool newest_step_state(double time, CartState& out) override {
+  bool newest_step_state(double time, CartState& out, StepStatistics& /*work*/) override {  // no evaluation
     if (!stepped_ || !(time >= dense_.previous_time() && time <= dense_.current_time())) return false;
     Joint x;
     if (time == dense_.current_time()) {

@@ -211,7 +211,7 @@ void Simulation::advance_output_to(double time) {
   if (!endless_ && time == end) steps_taken_ = schedule_.total_steps();  // at_end()
 }
 
-CartState Simulation::state_by_one_step(const CartState& from, double time) const {
+CartState Simulation::state_by_one_step(const CartState& from, double time, StepStatistics* work) const {
   if (takes_own_steps()) {
     throw std::logic_error("state_by_one_step() is for a member at fixed steps; " + scene_.integrator.name +
                            " takes its own steps: read its dense output (newest_step_state)");
@@ -225,7 +225,7 @@ CartState Simulation::state_by_one_step(const CartState& from, double time) cons
   if (!one_step_stepper_) one_step_stepper_ = make_cart_stepper(integrator_settings(scene_), model_, effects_);
   CartState next = from;
   StepStatistics uncounted;
-  one_step_stepper_->step(next, length, uncounted);
+  one_step_stepper_->step(next, length, work ? *work : uncounted);
   next.time = time;
   return next;
 }

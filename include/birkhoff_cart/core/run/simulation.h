@@ -103,16 +103,21 @@ class Simulation {
   void observe_grid(CartStepper::GridObserver observer);
   /// For a member with its own steps: the state at `time` [s] within its newest accepted own step,
   /// from its dense output, without moving the run (CartStepper::newest_step_state; a grid observer
-  /// may call it for the step it is told of: event location). False when there is none there.
-  bool newest_step_state(double time, CartState& out) const { return stepper_->newest_step_state(time, out); }
+  /// may call it for the step it is told of: event location). The evaluations it takes are added to
+  /// `*work` when given, never to statistics(). False when there is none there.
+  bool newest_step_state(double time, CartState& out, StepStatistics* work = nullptr) const {
+    StepStatistics uncounted;
+    return stepper_->newest_step_state(time, out, work ? *work : uncounted);
+  }
   /// For a member at fixed steps: the state at `time` [s] reached by one step of the member from
   /// `from` (a state of this run, from.time < time ≤ from.time + h), by a stepper of its own: the
   /// state between two steps to the member's order, the run, its stepper's memory and its counters
-  /// unmoved (event location at fixed steps). Throws std::logic_error for a member with its own
-  /// steps (newest_step_state reads their dense output) and for a scene with actuators or end
-  /// stops (their state moves with the run's steps); std::invalid_argument for a time outside
-  /// (from.time, from.time + (1 + 2·kMinFinalStepFraction) h]; StepError as a step.
-  CartState state_by_one_step(const CartState& from, double time) const;
+  /// unmoved (event location at fixed steps); its work is added to `*work` when given. Throws
+  /// std::logic_error for a member with its own steps (newest_step_state reads their dense output)
+  /// and for a scene with actuators or end stops (their state moves with the run's steps);
+  /// std::invalid_argument for a time outside (from.time, from.time + (1 + 2·kMinFinalStepFraction) h];
+  /// StepError as a step.
+  CartState state_by_one_step(const CartState& from, double time, StepStatistics* work = nullptr) const;
 
   /// An instant [s] a step control's own steps must end on exactly instead of interpolating there
   /// (CartStepper::land_on; the run's end always is one). For the current run only: reset() and
