@@ -4,7 +4,11 @@
 // the core's CartState, Diagnostics and guard values in SI units. The long loops (a batch of steps,
 // a run, a time grid) run in C++ with the GIL released, so a Python loop that advances many steps per
 // call pays the crossing once; calls on one Simulation from several threads take its lock one at a
-// time, waiting for it without the GIL. docs/python.md.
+// time, waiting for it without the GIL. solve() runs a scene whole and returns it shaped like
+// scipy's solve_ivp result: its own steps, t_eval's states and the events' crossings read on the way
+// from the member's dense output (Simulation::newest_step_state; at fixed steps one step of the
+// member beside the run, Simulation::state_by_one_step), located by crossing.h; only the event
+// functions are called with the GIL held. docs/python.md.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -13,6 +17,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -24,6 +29,7 @@
 #include "birkhoff_cart/core/scene/scene.h"
 #include "birkhoff_cart/core/support/version.h"
 #include "birkhoff_cart/core/run/guarded_run.h"
+#include "birkhoff_cart/core/integrators/crossing.h"
 #include "own_system_bindings.h"
 #include "scene_source.h"
 
@@ -278,6 +284,405 @@ void translate_exceptions(std::exception_ptr pending) {
   throw py::error_already_set();
 }
 
+// ---------------------------------------------------------------------------------------------
+// solve(): a whole run shaped like scipy's solve_ivp result (docs/python.md "solve").
+
+/// What solve() returns; its fields are set as attributes (py::dynamic_attr).
+struct SolveResult {};
+
+/// sol of a solve(): the run's states at any instants of [t0, t_final], by running the scene again
+/// to them (the member's own steps do not depend on the instants asked for, so the states are the
+/// run's own).
+struct DenseSolution {
+  Scene scene;
+  double t_min = 0.0;  ///< [s]
+  double t_max = 0.0;  ///< [s]
+};
+
+/// One event function of solve(): g(t, state) with solve_ivp's attributes.
+struct EventFunction {
+  py::object g;
+  double direction = 0.0;        ///< > 0: only − to +; < 0: only + to −; 0: both
+  std::uint64_t terminal_after = 0;  ///< stop at this occurrence (0: never)
+  std::vector<double> times;     ///< [s]
+  std::vector<CartState> states;
+};
+
+/// Thrown from the grid observer to stop a run at a terminal event.
+struct TerminalStop {};
+
+/// solve()'s default for the width of the bracket a crossing is located in [s] (locate_crossing).
+constexpr double kDefaultEventTolerance = 1e-12;
+
+std::vector<EventFunction> read_events(const py::object& events) {
+  std::vector<EventFunction> functions;
+  if (events.is_none()) return functions;
+  std::vector<py::object> given;
+  if (PyCallable_Check(events.ptr())) {
+    given.push_back(events);
+  } else {
+    for (const py::handle item : py::iter(events)) given.push_back(py::reinterpret_borrow<py::object>(item));
+  }
+  for (std::size_t i = 0; i < given.size(); ++i) {
+    const py::object& g = given[i];
+    if (!PyCallable_Check(g.ptr())) {
+      throw py::type_error("events[" + std::to_string(i) + "] must be a callable g(t, state), got " +
+                           std::string(py::repr(g)));
+    }
+    EventFunction function;
+    function.g = g;
+    const py::object direction = py::getattr(g, "direction", py::float_(0.0));
+    const py::object terminal = py::getattr(g, "terminal", py::bool_(false));
+    if (py::isinstance<py::str>(direction) || py::isinstance<py::bytes>(direction) ||
+        !PyNumber_Check(direction.ptr())) {
+      throw py::type_error("events[" + std::to_string(i) + "].direction must be a number, got " +
+                           std::string(py::repr(direction)));
+    }
+    function.direction = py::float_(direction);
+    if (py::isinstance<py::bool_>(terminal)) {
+      function.terminal_after = terminal.cast<bool>() ? 1 : 0;
+    } else if (py::isinstance<py::int_>(terminal)) {
+      const long long count = terminal.cast<long long>();
+      if (count < 0) throw py::value_error("events[" + std::to_string(i) + "].terminal must be >= 0");
+      function.terminal_after = static_cast<std::uint64_t>(count);
+    } else {
+      throw py::type_error("events[" + std::to_string(i) + "].terminal must be a bool or an int (solve_ivp's)");
+    }
+    functions.push_back(std::move(function));
+  }
+  return functions;
+}
+
+double event_value(const EventFunction& function, const CartState& state) {
+  const double value = py::float_(function.g(state.time, vector_array(state_row(state))));
+  if (std::isnan(value)) {
+    throw py::value_error("an event function returned NaN at t = " + std::to_string(state.time) + " s");
+  }
+  return value;
+}
+
+/// Does the step from g = before to g = after trigger `function` (solve_ivp's rule)?
+bool triggers(const EventFunction& function, double before, double after) {
+  const bool up = before <= 0.0 && after >= 0.0;
+  const bool down = before >= 0.0 && after <= 0.0;
+  if (function.direction > 0.0) return up;
+  if (function.direction < 0.0) return down;
+  return up || down;
+}
+
+/// A whole run of solve() (and of sol's runs again): the own steps, the states at t_eval, how it ended.
+struct DrivenRun {
+  std::vector<CartState> steps;    ///< the member's own steps from t0 (the schedule's at fixed steps)
+  std::vector<CartState> outputs;  ///< at t_eval
+  int status = 0;                  ///< 0: the end; 1: a terminal event; −1: a failed step
+  std::string message = "The solver successfully reached the end of the integration interval.";
+  std::size_t stopping_event = 0;
+  StepStatistics statistics;
+  StepStatistics reading;  ///< the work of reading t_eval and the crossings beside the run (dense output, one steps)
+  std::string integrator;
+};
+
+/// Refuses t_eval unless it increases within [t0, end] [s], naming the entry.
+void require_t_eval(const std::vector<double>& t_eval, double t0, double end) {
+  for (std::size_t j = 0; j < t_eval.size(); ++j) {
+    const double t = t_eval[j];
+    if (!(t >= t0 && t <= end) || (j > 0 && !(t > t_eval[j - 1]))) {
+      std::ostringstream text;
+      text.precision(17);
+      text << "t_eval[" << j << "] = " << t << " s: the times must increase within the run [" << t0 << ", " << end
+           << "] s";
+      throw py::value_error(text.str());
+    }
+  }
+}
+
+/// The scene's run from its start to its end or a terminal event. A member with its own steps is
+/// called for the scene's first step t0 + h (as cart_simulate's first step: dopri5 takes it as its
+/// first trial step) and then for the end; everything else is read on the way, at each own step,
+/// from the dense output of that step (Simulation::newest_step_state): t_eval's states and the
+/// events' crossings, located by locate_crossing to `event_tolerance` [s]. So the own steps do not
+/// depend on t_eval or the events, and a run again with other t_eval (sol) is the same run. A t_eval
+/// instant in a step without dense output (one that ends at an actuator's kink, where the grid
+/// restarts) is taken after the run by a run of its own to it (its dense output there). A member at
+/// fixed steps records the schedule's steps; its crossings are located on states reached by one
+/// step of the member from the step's start (Simulation::state_by_one_step); t_eval takes the
+/// schedule's instants, by a run of its own (GuardedRun::states_at). Event functions are called
+/// with the GIL held.
+DrivenRun drive(const Scene& scene, const std::vector<double>& t_eval, std::vector<EventFunction>& events,
+                double event_tolerance) {
+  DrivenRun run;
+  Simulation simulation(scene);
+  run.integrator = simulation.integrator_name();
+  const bool own_steps = simulation.takes_own_steps();
+  const double t0 = simulation.state().time;  // [s]
+  const double end = simulation.end_time();    // [s]
+  require_t_eval(t_eval, t0, end);
+  std::vector<std::uint64_t> t_eval_steps;  // at fixed steps: the step count of each t_eval instant
+  if (!own_steps) {
+    require_recordable(simulation.schedule().total_steps() + 1, "solve()'s steps");
+    for (double t : t_eval) {
+      t_eval_steps.push_back(schedule_step_at(simulation.schedule(), t, simulation.integrator_name()));
+    }
+  }
+  if (!own_steps && !events.empty()) {
+    try {  // refused here, by the core's reason, rather than at the first crossing
+      simulation.state_by_one_step(simulation.state(), t0 + 0.5 * simulation.step_size());
+    } catch (const std::logic_error& error) {
+      throw py::value_error(std::string("events at fixed steps: ") + error.what());
+    }
+  }
+
+  std::vector<CartState>& steps = run.steps;
+  std::vector<CartState>& outputs = run.outputs;
+  steps.push_back(simulation.state());
+  std::size_t next_output = 0;  // the next t_eval entry to output
+  std::vector<double> deferred;  // t_eval entries without dense output where they fell
+  std::vector<std::size_t> deferred_at;  // their places in outputs
+  for (; own_steps && next_output < t_eval.size() && t_eval[next_output] == t0; ++next_output) {
+    outputs.push_back(steps.front());
+  }
+  std::vector<double> g_now;
+  for (const EventFunction& function : events) g_now.push_back(event_value(function, simulation.state()));
+  CartState stop_state;
+  double stop_time = std::numeric_limits<double>::infinity();  // [s]
+
+  // The state at t inside the step from `before` (false: none there): the dense output of a member
+  // with its own steps, one step of the member from the step's start at fixed steps.
+  const auto state_in_step = [&](const CartState& before, double t, CartState& out) {
+    if (own_steps) return simulation.newest_step_state(t, out, &run.reading);
+    out = simulation.state_by_one_step(before, t, &run.reading);
+    return true;
+  };
+
+  // The crossings of the step from `before` to `after`, in time order, up to a terminal one (then
+  // true, with stop_time and stop_state set).
+  const auto crossings_in_step = [&](const CartState& before, const CartState& after) {
+    struct Found {
+      double time;  // [s]
+      std::size_t event;
+      CartState state;
+    };
+    std::vector<Found> found;
+    std::vector<double> g_next(events.size());
+    for (std::size_t i = 0; i < events.size(); ++i) {
+      g_next[i] = event_value(events[i], after);
+      if (!triggers(events[i], g_now[i], g_next[i])) continue;
+      if (g_now[i] == 0.0 && steps.size() == 1) continue;  // zero at the start: no crossing
+      CartState at = after;
+      double time = after.time;  // [s]
+      if (state_in_step(before, 0.5 * (before.time + after.time), at)) {
+        const auto g_at = [&](double t) {
+          CartState probe;
+          state_in_step(before, t, probe);
+          return event_value(events[i], probe);
+        };
+        time = locate_crossing(g_at, before.time, g_now[i], after.time, g_next[i], event_tolerance).time;
+        if (time == after.time) {
+          at = after;
+        } else if (time == before.time) {
+          at = before;
+        } else {
+          state_in_step(before, time, at);
+        }
+      } else {
+        // No dense output on this step (a grid restarted at an actuator's kink): the step's end,
+        // where g has reached zero or passed it, so that no crossing is reported early.
+        at = after;
+      }
+      found.push_back({time, i, at});
+    }
+    g_now = g_next;
+    std::stable_sort(found.begin(), found.end(), [](const Found& a, const Found& b) { return a.time < b.time; });
+    for (const Found& event : found) {
+      EventFunction& function = events[event.event];
+      function.times.push_back(event.time);
+      function.states.push_back(event.state);
+      if (function.terminal_after > 0 && function.times.size() >= function.terminal_after) {
+        stop_time = event.time;
+        stop_state = event.state;
+        run.stopping_event = event.event;
+        return true;
+      }
+    }
+    return false;
+  };
+
+  // Each own step: its crossings, then t_eval's instants in it up to a terminal crossing.
+  const auto on_step = [&](const CartState& stepped_to) {
+    if (steps.size() >= kMaxRecordedStates) require_recordable(steps.size() + 1, "solve()'s own steps");
+    // A step past the run's end (dopri5's and the reversible control's last, which the run leaves
+    // by a side step to the end) is read up to the end only, and not kept as an own step.
+    const bool beyond_end = stepped_to.time > end;
+    CartState clipped;
+    if (beyond_end && !simulation.newest_step_state(end, clipped, &run.reading)) return;
+    const CartState& grid_state = beyond_end ? clipped : stepped_to;
+    const bool stop = !events.empty() && crossings_in_step(steps.back(), grid_state);
+    const double reach = std::min(grid_state.time, stop_time);  // [s]
+    for (; next_output < t_eval.size() && t_eval[next_output] <= reach && t_eval[next_output] < end; ++next_output) {
+      const double t = t_eval[next_output];
+      CartState at = grid_state;
+      if (stop && t == stop_time) {
+        at = stop_state;
+      } else if (t != grid_state.time && !simulation.newest_step_state(t, at, &run.reading)) {
+        deferred.push_back(t);
+        deferred_at.push_back(outputs.size());
+      }
+      outputs.push_back(at);
+    }
+    if (stop) {
+      steps.push_back(stop_state);
+      throw TerminalStop{};
+    }
+    if (!beyond_end) steps.push_back(grid_state);
+  };
+
+  std::optional<py::gil_scoped_release> released;  // the GIL stays only for the event functions
+  if (events.empty()) released.emplace();
+  try {
+    if (own_steps) {
+      simulation.observe_grid(on_step);
+      try {
+        const double first = std::min(t0 + simulation.step_size(), end);  // [s]
+        simulation.advance_output_to(first);
+        if (first < end) simulation.advance_output_to(end);
+        // The run's end as an own step where the grid did not land on it (dopri5, the reversible
+        // control: their side step to the end).
+        if (steps.back().time != end) steps.push_back(simulation.state());
+        for (; next_output < t_eval.size(); ++next_output) outputs.push_back(steps.back());  // t_eval's end
+      } catch (const TerminalStop&) {
+        run.status = 1;
+        run.message = "A termination event occurred.";
+        for (; next_output < t_eval.size() && t_eval[next_output] <= stop_state.time; ++next_output) {
+          outputs.push_back(stop_state);  // at the end itself, which the steps leave to the run's end
+        }
+      }
+      simulation.observe_grid({});
+      if (!deferred.empty()) {
+        GuardedRun again(scene);
+        const std::vector<CartState> states = again.states_at(deferred);
+        for (std::size_t k = 0; k < states.size(); ++k) outputs[deferred_at[k]] = states[k];
+        run.reading.rhs_evaluations += again.simulation().statistics().rhs_evaluations;
+      }
+    } else {
+      try {
+        while (!simulation.at_end()) {
+          simulation.step_on_schedule();
+          if (!events.empty() && crossings_in_step(steps.back(), simulation.state())) {
+            run.status = 1;
+            run.message = "A termination event occurred.";
+            steps.push_back(stop_state);
+            break;
+          }
+          steps.push_back(simulation.state());
+        }
+      } catch (const StepError& error) {
+        run.status = -1;
+        run.message = error.what();
+      }
+      // t_eval: the schedule's steps the run reached (before a crossing that stopped it), and the
+      // crossing's own instant.
+      const std::size_t scheduled = run.status == 1 ? steps.size() - 1 : steps.size();  // steps[n]: after n steps
+      for (std::size_t j = 0; j < t_eval.size(); ++j) {
+        if (t_eval_steps[j] < scheduled && !(t_eval[j] > stop_time)) {
+          outputs.push_back(steps[t_eval_steps[j]]);
+        } else {
+          if (run.status == 1 && t_eval[j] == stop_time) outputs.push_back(stop_state);
+          break;
+        }
+      }
+    }
+  } catch (const StepError& error) {
+    simulation.observe_grid({});
+    run.status = -1;
+    run.message = error.what();
+  } catch (...) {
+    simulation.observe_grid({});
+    throw;
+  }
+  released.reset();
+  run.statistics = simulation.statistics();
+  return run;
+}
+
+std::vector<double> times_of(const py::object& given, const char* name) {
+  const auto times = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(given);
+  if (!times) throw py::type_error(std::string(name) + " must be numbers [s]");
+  return std::vector<double>(times.data(), times.data() + times.size());
+}
+
+py::object solve(const Scene& scene, const py::object& t_eval_given, bool dense_output, const py::object& events_given,
+                 double event_tolerance) {
+  if (!(event_tolerance > 0.0)) throw py::value_error("event_tolerance must be > 0 [s]");
+  std::vector<EventFunction> events = read_events(events_given);
+  const bool with_t_eval = !t_eval_given.is_none();
+  std::vector<double> t_eval;
+  if (with_t_eval) {
+    t_eval = times_of(t_eval_given, "t_eval");
+    require_recordable(t_eval.size(), "solve(t_eval of " + std::to_string(t_eval.size()) + " times)");
+  }
+  const DrivenRun run = drive(scene, t_eval, events, event_tolerance);
+  const std::vector<CartState>& shown = with_t_eval ? run.outputs : run.steps;
+  py::object result = py::cast(SolveResult{});
+  const py::object y = states_array(shown).attr("T").attr("copy")();  // STATE_FIELDS × times
+  result.attr("t") = y[py::int_(0)].attr("copy")();
+  result.attr("y") = y;
+  const py::object y_steps = states_array(run.steps).attr("T").attr("copy")();
+  result.attr("t_steps") = y_steps[py::int_(0)].attr("copy")();
+  result.attr("y_steps") = y_steps;
+  result.attr("sol") = dense_output ? py::cast(DenseSolution{scene, run.steps.front().time, run.steps.back().time})
+                                    : py::object(py::none());
+  py::list t_events, y_events;
+  for (const EventFunction& function : events) {
+    t_events.append(vector_array(function.times));
+    y_events.append(states_array(function.states));  // occurrences × STATE_FIELDS, as solve_ivp's
+  }
+  result.attr("t_events") = events.empty() ? py::object(py::none()) : py::object(t_events);
+  result.attr("y_events") = events.empty() ? py::object(py::none()) : py::object(y_events);
+  result.attr("nfev") = run.statistics.rhs_evaluations + run.reading.rhs_evaluations;
+  result.attr("njev") = py::none();  // no count kept: statistics["newton_iterations"] is the implicit members' work
+  result.attr("nlu") = py::none();
+  result.attr("nsteps") = run.steps.size() - 1;
+  result.attr("status") = run.status;
+  result.attr("message") = text(run.message);
+  result.attr("success") = run.status >= 0;
+  result.attr("integrator") = run.integrator;
+  result.attr("statistics") = statistics_dict(run.statistics);
+  result.attr("terminal_event") = run.status == 1 ? py::object(py::int_(run.stopping_event)) : py::object(py::none());
+  return result;
+}
+
+/// sol(t): the states at `t` (a number: STATE_FIELDS; numbers: STATE_FIELDS × len(t)), any order,
+/// by the same run again with t as its t_eval.
+py::object dense_states(const DenseSolution& dense, const py::object& t) {
+  const bool scalar = py::array::ensure(t) && py::array::ensure(t).ndim() == 0;
+  const std::vector<double> asked = times_of(t, "sol(t): t");
+  require_recordable(asked.size(), "sol(" + std::to_string(asked.size()) + " times)");
+  for (double time : asked) {
+    if (!(time >= dense.t_min && time <= dense.t_max)) {
+      std::ostringstream text;
+      text.precision(17);
+      text << "sol(t): t = " << time << " s is outside the run's [" << dense.t_min << ", " << dense.t_max << "] s";
+      throw py::value_error(text.str());
+    }
+  }
+  std::vector<double> sorted = asked;
+  std::sort(sorted.begin(), sorted.end());
+  sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+  std::vector<EventFunction> none;
+  const DrivenRun run = drive(dense.scene, sorted, none, kDefaultEventTolerance);
+  if (run.outputs.size() < sorted.size()) {  // the run failed before the last instant asked
+    throw py::value_error("sol(t): the run again ended before t = " + std::to_string(sorted[run.outputs.size()]) +
+                          " s: " + run.message);
+  }
+  std::vector<CartState> ordered;
+  ordered.reserve(asked.size());
+  for (double time : asked) {
+    ordered.push_back(run.outputs[std::lower_bound(sorted.begin(), sorted.end(), time) - sorted.begin()]);
+  }
+  if (scalar) return vector_array(state_row(ordered.front()));
+  return states_array(ordered).attr("T").attr("copy")();
+}
+
 }  // namespace
 }  // namespace python
 }  // namespace birkhoff_cart
@@ -351,6 +756,28 @@ PYBIND11_MODULE(simulator, m) {
              << "), h = " << s.integrator.step_size << " s, " << s.duration << " s>";
         return text.str();
       });
+
+  py::class_<SolveResult>(m, "SolveResult", py::dynamic_attr(),
+                          "What solve() returns, shaped like scipy's solve_ivp result (docs/python.md \"solve\").")
+      .def("__repr__", [](py::object self) {
+        std::ostringstream text;
+        text << "<SolveResult " << std::string(py::str(self.attr("integrator"))) << ": status "
+             << std::string(py::str(self.attr("status"))) << ", " << std::string(py::str(self.attr("nsteps")))
+             << " steps, " << std::string(py::str(self.attr("message"))) << ">";
+        return text.str();
+      });
+  py::class_<DenseSolution>(m, "DenseSolution",
+                            "sol of solve(dense_output=True): sol(t) is the run's state at t [s] (STATE_FIELDS; "
+                            "for an array of times STATE_FIELDS x len(t)), by running the scene again to them.")
+      .def("__call__", &dense_states, py::arg("t"))
+      .def_readonly("t_min", &DenseSolution::t_min, "[s]")
+      .def_readonly("t_max", &DenseSolution::t_max, "[s]");
+  m.def("solve", &solve, py::arg("scene"), py::arg("t_eval") = py::none(), py::arg("dense_output") = false,
+        py::arg("events") = py::none(), py::arg("event_tolerance") = kDefaultEventTolerance,
+        "The scene's whole run from its start, returned like scipy's solve_ivp: t, y (STATE_FIELDS x times), "
+        "t_steps and y_steps (the member's own steps), sol (dense_output=True), t_events and y_events (events: "
+        "callables g(t, state) with .terminal and .direction, located on the dense output, or at fixed steps on "
+        "one step of the member, to event_tolerance [s]), nfev, njev, nlu, nsteps, status, message, success, statistics. docs/python.md.");
 
   py::class_<SharedRun>(m, "Simulation",
                         "A running scene with its accuracy guard, checked where cart_simulate checks it: at the "

@@ -30,6 +30,17 @@ class ControlledCartStepper : public CartStepper {
   int order() const override { return Stepper::kOrder; }
   void land_on(double time) override { instants_.land_on(time); }
   void observe_grid(GridObserver observer) override { observer_ = std::move(observer); }
+  /// The grid's Hermite interpolant (grid_dense_output.h) on its newest step, on a copy of the
+  /// handed-out point: the run and its output stay as they were (the held points' rates it may
+  /// evaluate, counted in `work`, are the ones the next output would, which then takes them as known).
+  bool newest_step_state(double time, CartState& out, StepStatistics& work) override {
+    if (dense_.size() < 2 || !(time >= dense_.time(1) && time <= dense_.time(0))) return false;
+    Output probe = output_;
+    probe.periodic_angles = system_traits::periodic_angles(system_);
+    dense_.at(system_, time, probe, work);
+    out = probe.output(system_, time);
+    return true;
+  }
 
   void step(CartState& state, double step_size, StepStatistics& statistics) override {
     stepper_checks::require_valid_step_size(step_size);

@@ -50,6 +50,18 @@ class Dopri5RunCartStepper final : public CartStepper {
   bool symmetric() const override { return false; }
   void land_on(double time) override { instants_.land_on(time); }
   void observe_grid(GridObserver observer) override { observer_ = std::move(observer); }
+  /// odeint's dense output on the newest accepted step (its continuous extension), the run unmoved.
+  bool newest_step_state(double time, CartState& out, StepStatistics& /*work*/) override {  // no evaluation
+    if (!stepped_ || !(time >= dense_.previous_time() && time <= dense_.current_time())) return false;
+    Joint x;
+    if (time == dense_.current_time()) {
+      x = dense_.current_state();  // the step's end itself, as the run hands it out
+    } else {
+      dense_.calc_state(time, x);
+    }
+    out = cart_state_of(system_, x, time);
+    return true;
+  }
 
   void step(CartState& state, double step_size, StepStatistics& statistics) override {
     stepper_checks::require_valid_step_size(step_size);
@@ -60,6 +72,7 @@ class Dopri5RunCartStepper final : public CartStepper {
     valid_ = false;  // on failure: the next step starts afresh from the caller's unchanged state
     if (!continues) {
       dense_.initialize(joint_of(system_.to_birkhoffian(state)), time, guess_ > 0.0 ? guess_ : step_size);
+      stepped_ = false;
     }
     Joint x;
     std::uint64_t evaluations = 0;
@@ -69,6 +82,7 @@ class Dopri5RunCartStepper final : public CartStepper {
       while (dense_.current_time() < target) {
         if (++taken > DormandPrince5::kMaxInternalSteps) fail(time, target, "more than 100000 internal steps");
         dense_.do_step(rates);  // one accepted step (odeint retries rejected ones)
+        stepped_ = true;
         record_local_error_estimate(counted, trial_estimate_);
         ++counted.internal_steps;
         const double h = dense_.current_time() - dense_.previous_time();
@@ -156,6 +170,7 @@ class Dopri5RunCartStepper final : public CartStepper {
   Dense dense_;
   double guess_ = 0.0;           ///< the run's step size when it last handed a state out [s]
   GridObserver observer_;
+  bool stepped_ = false;  ///< dense_ holds an accepted step (newest_step_state)
   CartState last_output_;
   bool valid_ = false;
   OutputInstants instants_;

@@ -29,6 +29,8 @@ class GridDenseOutput {
   /// Forget the points (a restart of the grid).
   void clear() { history_.clear(); }
   int size() const { return history_.size(); }
+  /// The time of held point j (0: the newest) [s]; needs j < size().
+  double time(int j) const { return history_.time(j); }
 
   /// Adds the grid point of `grid` (a CarriedPoint) at time t [s]; with an identity chart, the
   /// rates its step's local error estimate evaluated there come along (first same as last: no

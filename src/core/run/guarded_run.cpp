@@ -146,33 +146,29 @@ std::vector<CartState> GuardedRun::dense_states_at(const std::vector<double>& ti
   return states;
 }
 
-std::vector<CartState> GuardedRun::grid_states_at(const std::vector<double>& times,
-                                                  const std::function<void(const Simulation&)>& observe) {
-  const StepSchedule& schedule = simulation_.schedule();
+std::uint64_t schedule_step_at(const StepSchedule& schedule, double time, const std::string& member) {
   const double h = schedule.step_size;  // [s]
-  const auto grid = [&]() {
+  if (std::abs(time - schedule.end_time) <= kTimeResolution * h) return schedule.total_steps();
+  const double steps = std::round((time - schedule.start_time) / h);
+  if (!(steps >= 0.0) || steps > static_cast<double>(schedule.whole_steps) ||
+      std::abs(schedule.grid_time(static_cast<std::uint64_t>(steps)) - time) > kTimeResolution * h) {
     std::ostringstream text;
     text.precision(17);
-    text << "the step schedule's instants t0 + n*h (t0 = " << schedule.start_time << " s, h = " << h
-         << " s) and its end " << schedule.end_time << " s: " << simulation_.integrator_name()
+    text << time_text(time) << " is not one of the step schedule's instants t0 + n*h (t0 = " << schedule.start_time
+         << " s, h = " << h << " s) and its end " << schedule.end_time << " s: " << member
          << " steps at fixed steps, and its states between them are not interpolated (a step control gives any "
             "instant)";
-    return text.str();
-  };
+    throw std::invalid_argument(text.str());
+  }
+  return static_cast<std::uint64_t>(steps);
+}
+
+std::vector<CartState> GuardedRun::grid_states_at(const std::vector<double>& times,
+                                                  const std::function<void(const Simulation&)>& observe) {
   // The step count at each time, checked before any step is taken.
   std::vector<std::uint64_t> targets;
   for (double time : times) {
-    std::uint64_t n = 0;
-    if (std::abs(time - schedule.end_time) <= kTimeResolution * h) {
-      n = schedule.total_steps();
-    } else {
-      const double steps = std::round((time - schedule.start_time) / h);
-      if (!(steps >= 0.0) || steps > static_cast<double>(schedule.whole_steps) ||
-          std::abs(schedule.grid_time(static_cast<std::uint64_t>(steps)) - time) > kTimeResolution * h) {
-        throw std::invalid_argument(time_text(time) + " is not one of " + grid());
-      }
-      n = static_cast<std::uint64_t>(steps);
-    }
+    const std::uint64_t n = schedule_step_at(simulation_.schedule(), time, simulation_.integrator_name());
     if (n < simulation_.steps_taken()) {
       std::ostringstream text;
       text.precision(17);

@@ -146,21 +146,29 @@ void Simulation::step_on_schedule() {
   else step_to(schedule_.end_time);
 }
 
+namespace {
+
+/// Refuses (std::invalid_argument, naming `call`) a step from t_n = `from` to `time` [s] that is not
+/// 0 < time − t_n ≤ (1 + 2·kMinFinalStepFraction) h: one step, a schedule's final one included.
+void require_one_step(const char* call, double from, double time, double step_size) {
+  const double longest = step_size * (1.0 + 2.0 * kMinFinalStepFraction);  // [s]
+  if (std::isfinite(time) && time - from > 0.0 && time - from <= longest) return;
+  std::ostringstream message;
+  message.precision(17);
+  message << call << "(" << time << " s) from t = " << from << " s needs 0 < t - t_n <= (1 + 2e-5) h = " << longest
+          << " s";
+  throw std::invalid_argument(message.str());
+}
+
+}  // namespace
+
 void Simulation::step_to(double time) {
   if (controlled_off_grid_) {
     throw std::logic_error("scene '" + scene_.name + "': advance_output_to() took this run off the step grid; " +
                            "continue with advance_output_to() or reset()");
   }
-  const double remaining = time - state_.time;  // [s]
-  const double longest = scene_.integrator.step_size * (1.0 + 2.0 * kMinFinalStepFraction);  // [s]
-  if (!std::isfinite(time) || !(remaining > 0.0) || remaining > longest) {
-    std::ostringstream message;
-    message.precision(17);
-    message << "step_to(" << time << " s) from t = " << state_.time << " s needs 0 < t - t_n <= (1 + 2e-5) h = "
-            << longest << " s";
-    throw std::invalid_argument(message.str());
-  }
-  take_step(remaining, time);
+  require_one_step("step_to", state_.time, time, scene_.integrator.step_size);
+  take_step(time - state_.time, time);
   finished_off_grid_ = true;
 }
 
@@ -201,6 +209,25 @@ void Simulation::advance_output_to(double time) {
   take_step(time - state_.time, time);
   controlled_off_grid_ = true;
   if (!endless_ && time == end) steps_taken_ = schedule_.total_steps();  // at_end()
+}
+
+CartState Simulation::state_by_one_step(const CartState& from, double time, StepStatistics* work) const {
+  if (takes_own_steps()) {
+    throw std::logic_error("state_by_one_step() is for a member at fixed steps; " + scene_.integrator.name +
+                           " takes its own steps: read its dense output (newest_step_state)");
+  }
+  if (effects_.steering_actuator() || effects_.drive_actuator() || effects_.end_stops()) {
+    throw std::logic_error("scene '" + scene_.name + "': state_by_one_step() cannot step beside the run: its "
+                           "actuators or end stops have a state of their own that moves with the run's steps");
+  }
+  require_one_step("state_by_one_step", from.time, time, scene_.integrator.step_size);
+  const double length = time - from.time;  // [s]
+  if (!one_step_stepper_) one_step_stepper_ = make_cart_stepper(integrator_settings(scene_), model_, effects_);
+  CartState next = from;
+  StepStatistics uncounted;
+  one_step_stepper_->step(next, length, work ? *work : uncounted);
+  next.time = time;
+  return next;
 }
 
 void Simulation::observe_grid(CartStepper::GridObserver observer) {

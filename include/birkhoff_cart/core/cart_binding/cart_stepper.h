@@ -42,6 +42,12 @@ class CartStepper {
   /// internal steps; nothing for the fixed-step members, whose steps are the caller's own).
   using GridObserver = std::function<void(const CartState& grid_state)>;
   virtual void observe_grid(GridObserver /*observer*/) {}
+  /// The state at `time` [s] within the member's newest accepted own step, from its dense output,
+  /// the run unmoved (event location: docs/python.md "solve"; a grid observer may call it for the
+  /// step it is told of); the evaluations it takes are added to `work`, never to the run's counters.
+  /// False when there is none there: `time` outside the newest step, no step of the current grid
+  /// yet (its start, a restart at an actuator's kink), a member at fixed steps.
+  virtual bool newest_step_state(double /*time*/, CartState& /*out*/, StepStatistics& /*work*/) { return false; }
 };
 
 /// Makes the registry's member settings.name (integrator_registry.h) for `model` and `effects`

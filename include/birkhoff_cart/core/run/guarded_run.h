@@ -11,6 +11,7 @@
 #include <functional>
 #include <limits>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "birkhoff_cart/core/scene/accuracy_guard.h"
@@ -30,6 +31,12 @@ enum class OutputInstants {
   kOutputRate,  ///< the start, t₀ + k/output_rate (every step when 1/output_rate is no whole number of steps), the end
   kCaller,      ///< only where the caller calls check() (cart_sim: its publish instants)
 };
+
+/// The step count n at which a run on `schedule` stands at `time` [s]: an instant t0 + n·h of its
+/// whole steps, or its end (total_steps()), each to kTimeResolution·h. std::invalid_argument naming
+/// the time and the schedule otherwise (`member`: the integrator, which steps at fixed steps and
+/// has no states between them).
+std::uint64_t schedule_step_at(const StepSchedule& schedule, double time, const std::string& member);
 
 class GuardedRun {
  public:

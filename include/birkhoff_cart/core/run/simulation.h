@@ -101,6 +101,23 @@ class Simulation {
   /// `observer` is called with the state after every accepted step of a step control's own grid
   /// (not for fixed-step members). Kept across reset() and restart_from(); an empty function stops it.
   void observe_grid(CartStepper::GridObserver observer);
+  /// For a member with its own steps: the state at `time` [s] within its newest accepted own step,
+  /// from its dense output, without moving the run (CartStepper::newest_step_state; a grid observer
+  /// may call it for the step it is told of: event location). The evaluations it takes are added to
+  /// `*work` when given, never to statistics(). False when there is none there.
+  bool newest_step_state(double time, CartState& out, StepStatistics* work = nullptr) const {
+    StepStatistics uncounted;
+    return stepper_->newest_step_state(time, out, work ? *work : uncounted);
+  }
+  /// For a member at fixed steps: the state at `time` [s] reached by one step of the member from
+  /// `from` (a state of this run, from.time < time ≤ from.time + h), by a stepper of its own: the
+  /// state between two steps to the member's order, the run, its stepper's memory and its counters
+  /// unmoved (event location at fixed steps); its work is added to `*work` when given. Throws
+  /// std::logic_error for a member with its own steps (newest_step_state reads their dense output)
+  /// and for a scene with actuators or end stops (their state moves with the run's steps);
+  /// std::invalid_argument for a time outside (from.time, from.time + (1 + 2·kMinFinalStepFraction) h];
+  /// StepError as a step.
+  CartState state_by_one_step(const CartState& from, double time, StepStatistics* work = nullptr) const;
 
   /// An instant [s] a step control's own steps must end on exactly instead of interpolating there
   /// (CartStepper::land_on; the run's end always is one). For the current run only: reset() and
@@ -163,6 +180,7 @@ class Simulation {
   bool finished_off_grid_ = false;  ///< step_to() left the grid t₀ + n h
   bool controlled_off_grid_ = false;  ///< advance_output_to() left the grid t₀ + n h
   CartStepper::GridObserver grid_observer_;
+  mutable std::unique_ptr<CartStepper> one_step_stepper_;  ///< state_by_one_step's own, made when first asked
   bool endless_ = false;            ///< plan_run(+inf): no end, schedule_ unused
   StepStatistics statistics_;
   double initial_energy_ = 0.0;
