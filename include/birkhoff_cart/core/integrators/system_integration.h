@@ -16,9 +16,9 @@
 //    the identity chart (time enters the time transformation as a passive coordinate).
 //
 // Events g(t, z) = 0 (as scipy's solve_ivp: a direction, terminal or not) are watched on every step:
-// where g changes sign over a step [tₐ, t_b], the crossing is located by the Illinois method on the
-// member's own step from (tₐ, zₐ) to τ, to |Δτ| ≤ 10⁻¹³·max(1 s, |τ|): the state there is the member's
-// state, not an interpolant's. A terminal event ends the run there (the last state is the event's).
+// where g changes sign over a step [tₐ, t_b], the crossing is located (crossing.h: Illinois,
+// safeguarded by bisection) on the member's own step from (tₐ, zₐ) to τ, to a bracket of
+// 10⁻¹³·max(1 s, |t_b|): the state there is the member's state, not an interpolant's. A terminal event ends the run there (the last state is the event's).
 #pragma once
 
 #include <Eigen/Core>
@@ -36,6 +36,7 @@
 #include "birkhoff_cart/core/integrators/adaptive_step_control.h"
 #include "birkhoff_cart/core/integrators/birkhoffian_system.h"
 #include "birkhoff_cart/core/integrators/carried_point.h"
+#include "birkhoff_cart/core/integrators/crossing.h"
 #include "birkhoff_cart/core/integrators/diagnostics.h"
 #include "birkhoff_cart/core/integrators/integrator_kind.h"
 #include "birkhoff_cart/core/integrators/integrator_members.h"
@@ -183,36 +184,16 @@ class EventWatch {
     return g;
   }
 
-  /// The Illinois method (regula falsi, the stale end's value halved) on τ ∈ [tₐ, t_b].
+  /// The crossing in τ ∈ [tₐ, t_b] (locate_crossing: Illinois, safeguarded by bisection), g read on the
+  /// member's state at τ by one step from (tₐ, zₐ).
   SystemEventCrossing<System> locate(std::size_t k, double ta, const Z& za, double ga, double tb, const Z& zb,
                                      double gb) {
     SystemEventCrossing<System> crossing{k, tb, zb};
     if (gb == 0.0) return crossing;
-    const Z start = za;
-    const double t_start = ta;
-    int stale = 0;  // +1: ta kept twice in a row, −1: tb
-    double previous = std::numeric_limits<double>::infinity();
-    for (int iteration = 0; iteration < 100; ++iteration) {
-      double tc = (ta * gb - tb * ga) / (gb - ga);
-      if (!(tc > ta && tc < tb)) tc = 0.5 * (ta + tb);
-      const Z zc = side_step_(t_start, start, tc);
-      const double gc = value(events_[k], tc, zc);
-      crossing.time = tc;
-      crossing.state = zc;
-      if (gc == 0.0 || std::abs(tc - previous) <= 1e-13 * std::max(1.0, std::abs(tc))) break;
-      previous = tc;
-      if ((gc > 0.0) == (gb > 0.0)) {
-        tb = tc;
-        gb = gc;
-        if (stale == 1) ga *= 0.5;
-        stale = 1;
-      } else {
-        ta = tc;
-        ga = gc;
-        if (stale == -1) gb *= 0.5;
-        stale = -1;
-      }
-    }
+    const auto g = [&](double tau) { return value(events_[k], tau, side_step_(ta, za, tau)); };
+    const Crossing found = locate_crossing(g, ta, ga, tb, gb, 1e-13 * std::max(1.0, std::abs(tb)));
+    crossing.time = found.time;
+    crossing.state = found.time == tb ? zb : side_step_(ta, za, found.time);
     return crossing;
   }
 
