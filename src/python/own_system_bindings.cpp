@@ -216,6 +216,13 @@ SystemSolution integrate(const py::object& system, const py::array_t<double, py:
                          const std::pair<double, double>& t_span, const std::string& integrator,
                          const py::object& step_size, const std::string& step_control, const py::object& tolerance,
                          std::uint64_t max_steps, const py::object& events) {
+  // Every step is a state of the result: the work limit is also its memory bound, at most the module's
+  // MAX_RECORDED_STATES (read from the module, so that one constant holds for every call).
+  const auto recorded_limit = py::module_::import("birkhoff_cart.simulator").attr("MAX_RECORDED_STATES").cast<std::uint64_t>();
+  if (max_steps < 1 || max_steps > recorded_limit) {
+    throw py::value_error("max_steps must be 1 ... MAX_RECORDED_STATES = " + std::to_string(recorded_limit) +
+                          " (every step is a state of the result), got " + std::to_string(max_steps));
+  }
   SystemRunRequest request;
   request.integrator = integrator;
   request.control = control_from(step_control);

@@ -255,6 +255,8 @@ def test_a_system_that_cannot_be_built_is_refused_by_name(make, words):
     ({"integrator": "birkhoff2", "step_control": "adaptive", "tolerance": 1e-6}, "not for 'birkhoff2'"),
     ({"integrator": "birkhoff4", "step_control": "adaptive", "tolerance": 1e-6}, "not for 'birkhoff4'"),
     ({"step_size": 1e-9, "max_steps": 1000}, "beyond max_steps"),
+    ({"step_size": 1e-9, "max_steps": 10 ** 12}, "max_steps must be 1 ... MAX_RECORDED_STATES"),
+    ({"step_size": 0.1, "max_steps": 0}, "max_steps must be 1 ... MAX_RECORDED_STATES"),
 ])
 def test_a_request_that_cannot_be_run_is_refused_by_name(kwargs, words):
     with pytest.raises(ValueError, match=words):
