@@ -376,3 +376,33 @@ def test_bad_events_are_refused_by_name(events, words):
 def test_an_event_that_returns_nan_is_refused_by_name():
     with pytest.raises(ValueError, match="event function returned NaN"):
         simulator.integrate(pendulum(), PENDULUM_START, (0.0, 1.0), step_size=0.1, events=lambda t, z: float("nan"))
+
+
+def test_threads_integrating_their_own_systems_get_the_one_thread_result():
+    # integrate() holds the GIL, which the interpreter hands between threads inside the callbacks: four
+    # runs interleave at every evaluation. In a child with a timeout (test_simulator_hostile.run_child),
+    # so that a hang fails instead of hanging the suite.
+    from test_simulator_hostile import run_child
+    out = run_child("""
+        import math, threading
+        import numpy as np
+        from birkhoff_cart import simulator
+        def pendulum():
+            return simulator.BirkhoffianSystem(2, birkhoffian_gradient=lambda z, t: (math.sin(z[0]), z[1]))
+        def run():
+            return simulator.integrate(pendulum(), (2.0, 0.0), (0.0, 20.0), "birkhoff_gauss8", step_control="adaptive",
+                                       tolerance=1e-10)
+        expected = run()
+        results = [None] * 4
+        def work(k):
+            results[k] = run()
+        for attempt in range(5):
+            threads = [threading.Thread(target=work, args=(k,)) for k in range(4)]
+            for thread in threads:
+                thread.start()
+            for thread in threads:
+                thread.join()
+            assert all(np.array_equal(result.y, expected.y) for result in results)
+        print("same", expected.nfev)
+    """)
+    assert out.startswith("same")
