@@ -12,6 +12,7 @@
 
 #include "birkhoff_cart/core/examples/chaplygin_sleigh.h"
 #include "birkhoff_cart/core/integrators/system_integration.h"
+#include "event_specs.h"
 #include "python_system.h"
 
 namespace birkhoff_cart {
@@ -103,30 +104,21 @@ SystemStepControl control_from(const std::string& name) {
   throw py::value_error("step_control must be 'fixed', 'adaptive' or 'reversible', got '" + name + "'");
 }
 
-/// The events of integrate(): a callable g(t, z), or a sequence of them, each with the optional
-/// attributes `terminal` (bool) and `direction` (number; its sign counts), as scipy's solve_ivp.
+/// The events of integrate(), read as solve() reads them (event_specs.h); a system's run stops at an
+/// event's first crossing, so `terminal` is True or False (or 0 or 1) here.
 template <class System>
 std::vector<SystemEvent<System>> events_from(const py::object& given) {
   std::vector<SystemEvent<System>> events;
-  if (given.is_none()) return events;
-  std::vector<py::object> functions;
-  if (PyCallable_Check(given.ptr())) {
-    functions.push_back(given);
-  } else {
-    for (const py::handle item : py::iter(given)) functions.push_back(py::reinterpret_borrow<py::object>(item));
-  }
-  for (std::size_t k = 0; k < functions.size(); ++k) {
-    const py::object function = functions[k];
-    if (!PyCallable_Check(function.ptr())) {
-      throw py::type_error("events[" + std::to_string(k) + "] must be a callable g(t, z), got " +
-                           py::repr(function).cast<std::string>());
+  const std::vector<EventSpec> specs = read_event_specs(given);
+  for (std::size_t k = 0; k < specs.size(); ++k) {
+    if (specs[k].terminal_after > 1) {
+      throw py::value_error("events[" + std::to_string(k) + "].terminal must be True or False for integrate() (it "
+                            "stops at the first crossing), got " + std::to_string(specs[k].terminal_after));
     }
+    const py::object function = specs[k].g;
     SystemEvent<System> event;
-    event.terminal = py::hasattr(function, "terminal") && py::bool_(function.attr("terminal"));
-    if (py::hasattr(function, "direction")) {
-      const double direction = function.attr("direction").cast<double>();
-      event.direction = direction > 0.0 ? 1 : (direction < 0.0 ? -1 : 0);
-    }
+    event.terminal = specs[k].terminal_after == 1;
+    event.direction = specs[k].direction > 0.0 ? 1 : (specs[k].direction < 0.0 ? -1 : 0);
     event.function = [function, k](double t, const StateVector<System, double>& z) {
       py::array_t<double> state(System::kDimension);
       for (int i = 0; i < System::kDimension; ++i) state.mutable_at(i) = z(i);

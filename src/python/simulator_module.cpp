@@ -30,6 +30,7 @@
 #include "birkhoff_cart/core/support/version.h"
 #include "birkhoff_cart/core/run/guarded_run.h"
 #include "birkhoff_cart/core/integrators/crossing.h"
+#include "event_specs.h"
 #include "own_system_bindings.h"
 #include "scene_source.h"
 
@@ -316,38 +317,11 @@ constexpr double kDefaultEventTolerance = 1e-12;
 
 std::vector<EventFunction> read_events(const py::object& events) {
   std::vector<EventFunction> functions;
-  if (events.is_none()) return functions;
-  std::vector<py::object> given;
-  if (PyCallable_Check(events.ptr())) {
-    given.push_back(events);
-  } else {
-    for (const py::handle item : py::iter(events)) given.push_back(py::reinterpret_borrow<py::object>(item));
-  }
-  for (std::size_t i = 0; i < given.size(); ++i) {
-    const py::object& g = given[i];
-    if (!PyCallable_Check(g.ptr())) {
-      throw py::type_error("events[" + std::to_string(i) + "] must be a callable g(t, state), got " +
-                           std::string(py::repr(g)));
-    }
+  for (const python::EventSpec& spec : python::read_event_specs(events)) {
     EventFunction function;
-    function.g = g;
-    const py::object direction = py::getattr(g, "direction", py::float_(0.0));
-    const py::object terminal = py::getattr(g, "terminal", py::bool_(false));
-    if (py::isinstance<py::str>(direction) || py::isinstance<py::bytes>(direction) ||
-        !PyNumber_Check(direction.ptr())) {
-      throw py::type_error("events[" + std::to_string(i) + "].direction must be a number, got " +
-                           std::string(py::repr(direction)));
-    }
-    function.direction = py::float_(direction);
-    if (py::isinstance<py::bool_>(terminal)) {
-      function.terminal_after = terminal.cast<bool>() ? 1 : 0;
-    } else if (py::isinstance<py::int_>(terminal)) {
-      const long long count = terminal.cast<long long>();
-      if (count < 0) throw py::value_error("events[" + std::to_string(i) + "].terminal must be >= 0");
-      function.terminal_after = static_cast<std::uint64_t>(count);
-    } else {
-      throw py::type_error("events[" + std::to_string(i) + "].terminal must be a bool or an int (solve_ivp's)");
-    }
+    function.g = spec.g;
+    function.direction = spec.direction;
+    function.terminal_after = spec.terminal_after;
     functions.push_back(std::move(function));
   }
   return functions;
