@@ -3,6 +3,7 @@
 //   cart_simulate --scene FILE [--integrator NAME] [--step H] [--tolerance TOL] [--duration T]
 //                 [--output-rate HZ] [--birkhoffian-form F] [--quiet] [--step-control C]
 //                 [--position-tolerance M] [--on-accuracy-error fail|warn] [--random-scene SEED:K]
+//                 [--event FIELD=VALUE[,rising|falling][,terminal]]...
 //                 --output FILE.csv   (also --option=value)
 //   cart_simulate --help | -h | --version
 //   cart_simulate --list-integrators [--json]
@@ -24,6 +25,10 @@
 // (the scene's `accuracy` limits, checked at every row). The run is cut
 // into steps by the rule of step_schedule.h (Simulation::step_on_schedule): the last row is at
 // t0 + T exactly.
+// Events (--event, repeatable; docs/events.md): each crossing of a state field through a value is
+// located on the member's own step to 1e-12 s (state_events.h) and printed on stdout as a line
+// "event NAME at t = … s: x = …" before the summary; a terminal one stops the run at the first step
+// of the schedule that reached it (no row after its time; a line says so).
 // Progress: a run longer than a second of wall time reports, at most once a second on stderr,
 // the percentage of scene time done and the real-time factor (unless --quiet).
 // Exit status: 0 done (also --help, --version); 2 bad arguments (usage on stderr); 3 unusable
@@ -58,6 +63,7 @@
 #include "birkhoff_cart/core/scene/scene.h"
 #include "birkhoff_cart/core/physics/sensors/odometry_sensor.h"
 #include "birkhoff_cart/core/run/simulation.h"
+#include "birkhoff_cart/core/run/state_events.h"
 #include "birkhoff_cart/core/scene/step_schedule.h"
 #include "birkhoff_cart/core/support/version.h"
 
@@ -174,7 +180,8 @@ std::string usage() {
          "                     [--duration T] [--output-rate HZ] [--birkhoffian-form F] [--quiet]\n"
          "                     [--step-control " + alternatives(birkhoff_cart::step_control_names(), "|", "|") +
          "] [--position-tolerance M]\n"
-         "                     [--on-accuracy-error fail|warn] [--random-scene SEED:K] --output FILE.csv\n"
+         "                     [--on-accuracy-error fail|warn] [--random-scene SEED:K]\n"
+         "                     [--event FIELD=VALUE[,rising|falling][,terminal]]... --output FILE.csv\n"
          "       cart_simulate --help | -h | --version\n"
          "       cart_simulate --list-integrators [--json]   (the table below; --json: for programs)\n"
          "  --scene FILE            scene YAML (config/scenes/*.yaml); it provides every default\n"
@@ -195,6 +202,11 @@ std::string usage() {
          "  --random-scene SEED:K   scene K of the seeded random family (a random valid cart, start, step,\n"
          "                          duration and effects; docs/accuracy.md §3) instead of the file's, which\n"
          "                          gives the rest (integrator, accuracy guard); the other options still apply\n"
+         "  --event E               record when a state field crosses a value, e.g. chi=0.3,rising,terminal\n"
+         "                          (FIELD: t x y theta chi phi1..phi4 pi1 omega1 omega2, SI units; rising,\n"
+         "                          falling or both; terminal stops the run there). Repeatable. Each crossing,\n"
+         "                          located on the member's own step to 1e-12 s, is a line 'event ...' on\n"
+         "                          stdout (docs/events.md)\n"
          "  --on-accuracy-error A   fail (default: exit 5 when the scene's accuracy guard reaches ERROR)\n"
          "                          or warn (exit 0; the summary still names the quantity)\n"
          "  --output FILE.csv       where to write t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,\n"
@@ -239,7 +251,7 @@ std::map<std::string, std::string> parse_arguments(int argc, char** argv) {
   static const char* const kOptions[] = {"--scene",       "--integrator",       "--step",  "--tolerance",
                                          "--duration",    "--output-rate",      "--birkhoffian-form", "--output",
                                          "--on-accuracy-error", "--step-control", "--random-scene",
-                                         "--position-tolerance"};
+                                         "--position-tolerance", "--event"};
   std::map<std::string, std::string> values;
   for (int i = 1; i < argc; ++i) {
     std::string option = argv[i];
@@ -259,8 +271,15 @@ std::map<std::string, std::string> parse_arguments(int argc, char** argv) {
     for (const char* candidate : kOptions) known = known || option == candidate;
     if (!known) throw UsageError("unknown argument '" + std::string(argv[i]) + "'");
     if (!attached && i + 1 >= argc) throw UsageError("option " + option + " needs a value");
+    const std::string value = attached ? *attached : argv[++i];
+    if (option == "--event") {  // repeatable: the events, one per line
+      if (value.find('\n') != std::string::npos) throw UsageError("option --event: a line break in '" + value + "'");
+      values[option] += (values.count(option) && !values[option].empty() ? "\n" : "") + value;
+      if (value.empty()) throw UsageError("option --event needs FIELD=VALUE[,rising|falling][,terminal], got ''");
+      continue;
+    }
     if (values.count(option)) throw UsageError("option " + option + " given twice");
-    values[option] = attached ? *attached : argv[++i];
+    values[option] = value;
   }
   if (!values.count("--scene")) throw UsageError("missing --scene FILE");
   if (!values.count("--output")) throw UsageError("missing --output FILE.csv");
@@ -398,6 +417,22 @@ class ProgressReport {
   Clock::time_point wall_start_, next_report_;
 };
 
+/// The --event options' events (given one per line), a UsageError naming a malformed one.
+std::vector<birkhoff_cart::StateEvent> parse_events(const std::string& lines) {
+  std::vector<birkhoff_cart::StateEvent> events;
+  std::string::size_type from = 0;
+  for (;;) {
+    const std::string::size_type end = lines.find('\n', from);
+    try {
+      events.push_back(birkhoff_cart::state_field_event(lines.substr(from, end == std::string::npos ? end : end - from)));
+    } catch (const std::invalid_argument& error) {
+      throw UsageError(std::string("option --event: ") + error.what());
+    }
+    if (end == std::string::npos) return events;
+    from = end + 1;
+  }
+}
+
 /// Closes the CSV; false (with errno) when any write failed.
 bool close_output(std::FILE* file) {
   const bool write_failed = std::ferror(file) != 0;
@@ -417,11 +452,13 @@ int run(int argc, char** argv) {
   if (listed >= 0) return listed;
   std::map<std::string, std::string> arguments;
   Scene scene;
+  std::vector<birkhoff_cart::StateEvent> events;
   try {
     arguments = parse_arguments(argc, argv);
     scene = birkhoff_cart::load_scene(arguments.at("--scene"));
     if (arguments.count("--random-scene")) scene = random_scene(arguments.at("--random-scene"), scene);
     apply_overrides(arguments, scene);
+    if (arguments.count("--event")) events = parse_events(arguments.at("--event"));
   } catch (const UsageError& error) {
     std::fprintf(stderr, "cart_simulate: %s\n%s", error.what(), usage().c_str());
     return kExitUsage;
@@ -472,12 +509,52 @@ int run(int argc, char** argv) {
     if (std::ferror(file)) throw OutputError(std::string("writing the CSV failed: ") + std::strerror(errno));
     ++rows;
   };
+  // The events: crossings located on each own step of a member with its own steps (the grid
+  // observer), else on each step of the schedule; printed when the run ends or stops.
+  std::optional<birkhoff_cart::EventLocator> locator;
+  if (!events.empty()) {
+    try {
+      locator.emplace(simulation, events);
+    } catch (const std::invalid_argument& error) {
+      std::fclose(file);
+      std::fprintf(stderr, "cart_simulate: %s\n", error.what());
+      return kExitSettings;
+    }
+    if (simulation.takes_own_steps()) {
+      guarded_run->simulation().observe_grid([&](const CartState& stepped_to) { locator->step_to(stepped_to); });
+    }
+  }
+  const auto print_events = [&] {
+    struct Line {
+      double time;  // [s]
+      std::string text;
+    };
+    std::vector<Line> lines;
+    for (const birkhoff_cart::StateEvent& event : events) {
+      for (std::size_t k = 0; k < event.times.size(); ++k) {
+        lines.push_back({event.times[k], birkhoff_cart::describe_occurrence(event, k)});
+      }
+    }
+    std::stable_sort(lines.begin(), lines.end(), [](const Line& a, const Line& b) { return a.time < b.time; });
+    for (const Line& line : lines) std::printf("event %s\n", line.text.c_str());
+    if (locator && locator->stopped()) {
+      std::printf("cart_simulate: stopped by the terminal event %s at t = %.17g s (the run stopped at the first "
+                  "step that reached it, t = %.17g s; no row after the event)\n",
+                  events[locator->stopping_event()].name.c_str(), locator->stop_state().time, simulation.state().time);
+    }
+  };
   try {
     write_state(start_time);
     // A row at each output instant the run reaches (t0 + k/HZ on the whole steps, and the end t0 + T).
     while (!simulation.at_end()) {
-      if (const std::optional<double> instant = guarded_run->step()) write_state(*instant);
+      const std::optional<double> instant = guarded_run->step();
+      if (locator && !simulation.takes_own_steps()) locator->step_to(simulation.state());
+      // A member with its own steps may find a terminal crossing ahead of the schedule (its own
+      // step reaches beyond the step asked for): the rows up to the crossing are still written.
+      const bool stopped = locator && locator->stopped();
+      if (instant && !(stopped && *instant > locator->stop_state().time)) write_state(*instant);
       progress.update(simulation.state().time);
+      if (stopped && simulation.state().time >= locator->stop_state().time) break;
     }
   } catch (const OutputError& error) {
     close_output(file);
@@ -490,6 +567,7 @@ int run(int argc, char** argv) {
                  dynamic_cast<const birkhoff_cart::StepError*>(&error) ? "step failed" : "run stopped",
                  simulation.state().time, static_cast<unsigned long long>(rows),
                  kept ? "written to" : "NOT all written to", output_path.c_str(), error.what());
+    print_events();
     std::printf("cart_simulate %s", birkhoff_cart::run_summary(simulation, guard).c_str());
     return kExitStepFailed;
   }
@@ -497,6 +575,7 @@ int run(int argc, char** argv) {
     std::fprintf(stderr, "cart_simulate: error writing '%s': %s\n", output_path.c_str(), std::strerror(errno));
     return kExitSettings;
   }
+  print_events();
   std::printf("cart_simulate %s", birkhoff_cart::run_summary(simulation, guard).c_str());
   if (sensor) std::printf("%s\n", birkhoff_cart::odometry_drift_line(*sensor, simulation.state(), simulation.model()).c_str());
   if (guard.level() == birkhoff_cart::AccuracyLevel::kError) {

@@ -7,7 +7,7 @@
 // time, waiting for it without the GIL. solve() runs a scene whole and returns it shaped like
 // scipy's solve_ivp result: its own steps, t_eval's states and the events' crossings read on the way
 // from the member's dense output (Simulation::newest_step_state; at fixed steps one step of the
-// member beside the run, Simulation::state_by_one_step), located by crossing.h; only the event
+// member beside the run, Simulation::state_by_one_step), located by the core's EventLocator (state_events.h); only the event
 // functions are called with the GIL held. docs/python.md.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -29,7 +29,7 @@
 #include "birkhoff_cart/core/scene/scene.h"
 #include "birkhoff_cart/core/support/version.h"
 #include "birkhoff_cart/core/run/guarded_run.h"
-#include "birkhoff_cart/core/integrators/crossing.h"
+#include "birkhoff_cart/core/run/state_events.h"
 #include "event_specs.h"
 #include "own_system_bindings.h"
 #include "scene_source.h"
@@ -300,48 +300,28 @@ struct DenseSolution {
   double t_max = 0.0;  ///< [s]
 };
 
-/// One event function of solve(): g(t, state) with solve_ivp's attributes.
-struct EventFunction {
-  py::object g;
-  double direction = 0.0;        ///< > 0: only − to +; < 0: only + to −; 0: both
-  std::uint64_t terminal_after = 0;  ///< stop at this occurrence (0: never)
-  std::vector<double> times;     ///< [s]
-  std::vector<CartState> states;
-};
-
 /// Thrown from the grid observer to stop a run at a terminal event.
 struct TerminalStop {};
 
 /// solve()'s default for the width of the bracket a crossing is located in [s] (locate_crossing).
-constexpr double kDefaultEventTolerance = 1e-12;
+constexpr double kDefaultEventTolerance = EventLocator::kDefaultTimeTolerance;
 
-std::vector<EventFunction> read_events(const py::object& events) {
-  std::vector<EventFunction> functions;
+/// solve()'s events as the core's (state_events.h): g(t, state) called on a STATE_FIELDS row, with
+/// the GIL held (drive() keeps it while there are events).
+std::vector<StateEvent> read_events(const py::object& events) {
+  std::vector<StateEvent> functions;
+  std::size_t index = 0;
   for (const python::EventSpec& spec : python::read_event_specs(events)) {
-    EventFunction function;
-    function.g = spec.g;
-    function.direction = spec.direction;
-    function.terminal_after = spec.terminal_after;
-    functions.push_back(std::move(function));
+    StateEvent event;
+    event.name = "events[" + std::to_string(index++) + "]";
+    event.g = [g = spec.g](const CartState& state) {
+      return py::float_(g(state.time, vector_array(state_row(state)))).cast<double>();
+    };
+    event.direction = spec.direction;
+    event.terminal_after = spec.terminal_after;
+    functions.push_back(std::move(event));
   }
   return functions;
-}
-
-double event_value(const EventFunction& function, const CartState& state) {
-  const double value = py::float_(function.g(state.time, vector_array(state_row(state))));
-  if (std::isnan(value)) {
-    throw py::value_error("an event function returned NaN at t = " + std::to_string(state.time) + " s");
-  }
-  return value;
-}
-
-/// Does the step from g = before to g = after trigger `function` (solve_ivp's rule)?
-bool triggers(const EventFunction& function, double before, double after) {
-  const bool up = before <= 0.0 && after >= 0.0;
-  const bool down = before >= 0.0 && after <= 0.0;
-  if (function.direction > 0.0) return up;
-  if (function.direction < 0.0) return down;
-  return up || down;
 }
 
 /// A whole run of solve() (and of sol's runs again): the own steps, the states at t_eval, how it ended.
@@ -382,7 +362,7 @@ void require_t_eval(const std::vector<double>& t_eval, double t0, double end) {
 /// step of the member from the step's start (Simulation::state_by_one_step); t_eval takes the
 /// schedule's instants, by a run of its own (GuardedRun::states_at). Event functions are called
 /// with the GIL held.
-DrivenRun drive(const Scene& scene, const std::vector<double>& t_eval, std::vector<EventFunction>& events,
+DrivenRun drive(const Scene& scene, const std::vector<double>& t_eval, std::vector<StateEvent>& events,
                 double event_tolerance) {
   DrivenRun run;
   Simulation simulation(scene);
@@ -398,12 +378,11 @@ DrivenRun drive(const Scene& scene, const std::vector<double>& t_eval, std::vect
       t_eval_steps.push_back(schedule_step_at(simulation.schedule(), t, simulation.integrator_name()));
     }
   }
-  if (!own_steps && !events.empty()) {
-    try {  // refused here, by the core's reason, rather than at the first crossing
-      simulation.state_by_one_step(simulation.state(), t0 + 0.5 * simulation.step_size());
-    } catch (const std::logic_error& error) {
-      throw py::value_error(std::string("events at fixed steps: ") + error.what());
-    }
+  std::optional<EventLocator> locator;  // refuses, by the core's reason, events it cannot locate
+  try {
+    if (!events.empty()) locator.emplace(simulation, events, event_tolerance, &run.reading);
+  } catch (const std::invalid_argument& error) {
+    throw py::value_error(error.what());
   }
 
   std::vector<CartState>& steps = run.steps;
@@ -415,70 +394,15 @@ DrivenRun drive(const Scene& scene, const std::vector<double>& t_eval, std::vect
   for (; own_steps && next_output < t_eval.size() && t_eval[next_output] == t0; ++next_output) {
     outputs.push_back(steps.front());
   }
-  std::vector<double> g_now;
-  for (const EventFunction& function : events) g_now.push_back(event_value(function, simulation.state()));
   CartState stop_state;
   double stop_time = std::numeric_limits<double>::infinity();  // [s]
-
-  // The state at t inside the step from `before` (false: none there): the dense output of a member
-  // with its own steps, one step of the member from the step's start at fixed steps.
-  const auto state_in_step = [&](const CartState& before, double t, CartState& out) {
-    if (own_steps) return simulation.newest_step_state(t, out, &run.reading);
-    out = simulation.state_by_one_step(before, t, &run.reading);
+  // The crossings of the step to `after` up to a terminal one (then true, with stop_time and stop_state set).
+  const auto crossings_in_step = [&](const CartState& after) {
+    if (!locator->step_to(after)) return false;
+    stop_state = locator->stop_state();
+    stop_time = events[locator->stopping_event()].times.back();
+    run.stopping_event = locator->stopping_event();
     return true;
-  };
-
-  // The crossings of the step from `before` to `after`, in time order, up to a terminal one (then
-  // true, with stop_time and stop_state set).
-  const auto crossings_in_step = [&](const CartState& before, const CartState& after) {
-    struct Found {
-      double time;  // [s]
-      std::size_t event;
-      CartState state;
-    };
-    std::vector<Found> found;
-    std::vector<double> g_next(events.size());
-    for (std::size_t i = 0; i < events.size(); ++i) {
-      g_next[i] = event_value(events[i], after);
-      if (!triggers(events[i], g_now[i], g_next[i])) continue;
-      if (g_now[i] == 0.0 && steps.size() == 1) continue;  // zero at the start: no crossing
-      CartState at = after;
-      double time = after.time;  // [s]
-      if (state_in_step(before, 0.5 * (before.time + after.time), at)) {
-        const auto g_at = [&](double t) {
-          CartState probe;
-          state_in_step(before, t, probe);
-          return event_value(events[i], probe);
-        };
-        time = locate_crossing(g_at, before.time, g_now[i], after.time, g_next[i], event_tolerance).time;
-        if (time == after.time) {
-          at = after;
-        } else if (time == before.time) {
-          at = before;
-        } else {
-          state_in_step(before, time, at);
-        }
-      } else {
-        // No dense output on this step (a grid restarted at an actuator's kink): the step's end,
-        // where g has reached zero or passed it, so that no crossing is reported early.
-        at = after;
-      }
-      found.push_back({time, i, at});
-    }
-    g_now = g_next;
-    std::stable_sort(found.begin(), found.end(), [](const Found& a, const Found& b) { return a.time < b.time; });
-    for (const Found& event : found) {
-      EventFunction& function = events[event.event];
-      function.times.push_back(event.time);
-      function.states.push_back(event.state);
-      if (function.terminal_after > 0 && function.times.size() >= function.terminal_after) {
-        stop_time = event.time;
-        stop_state = event.state;
-        run.stopping_event = event.event;
-        return true;
-      }
-    }
-    return false;
   };
 
   // Each own step: its crossings, then t_eval's instants in it up to a terminal crossing.
@@ -490,7 +414,7 @@ DrivenRun drive(const Scene& scene, const std::vector<double>& t_eval, std::vect
     CartState clipped;
     if (beyond_end && !simulation.newest_step_state(end, clipped, &run.reading)) return;
     const CartState& grid_state = beyond_end ? clipped : stepped_to;
-    const bool stop = !events.empty() && crossings_in_step(steps.back(), grid_state);
+    const bool stop = !events.empty() && crossings_in_step(grid_state);
     const double reach = std::min(grid_state.time, stop_time);  // [s]
     for (; next_output < t_eval.size() && t_eval[next_output] <= reach && t_eval[next_output] < end; ++next_output) {
       const double t = t_eval[next_output];
@@ -541,7 +465,7 @@ DrivenRun drive(const Scene& scene, const std::vector<double>& t_eval, std::vect
       try {
         while (!simulation.at_end()) {
           simulation.step_on_schedule();
-          if (!events.empty() && crossings_in_step(steps.back(), simulation.state())) {
+          if (!events.empty() && crossings_in_step(simulation.state())) {
             run.status = 1;
             run.message = "A termination event occurred.";
             steps.push_back(stop_state);
@@ -587,7 +511,7 @@ std::vector<double> times_of(const py::object& given, const char* name) {
 py::object solve(const Scene& scene, const py::object& t_eval_given, bool dense_output, const py::object& events_given,
                  double event_tolerance) {
   if (!(event_tolerance > 0.0)) throw py::value_error("event_tolerance must be > 0 [s]");
-  std::vector<EventFunction> events = read_events(events_given);
+  std::vector<StateEvent> events = read_events(events_given);
   const bool with_t_eval = !t_eval_given.is_none();
   std::vector<double> t_eval;
   if (with_t_eval) {
@@ -606,7 +530,7 @@ py::object solve(const Scene& scene, const py::object& t_eval_given, bool dense_
   result.attr("sol") = dense_output ? py::cast(DenseSolution{scene, run.steps.front().time, run.steps.back().time})
                                     : py::object(py::none());
   py::list t_events, y_events;
-  for (const EventFunction& function : events) {
+  for (const StateEvent& function : events) {
     t_events.append(vector_array(function.times));
     y_events.append(states_array(function.states));  // occurrences × STATE_FIELDS, as solve_ivp's
   }
@@ -642,7 +566,7 @@ py::object dense_states(const DenseSolution& dense, const py::object& t) {
   std::vector<double> sorted = asked;
   std::sort(sorted.begin(), sorted.end());
   sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
-  std::vector<EventFunction> none;
+  std::vector<StateEvent> none;
   const DrivenRun run = drive(dense.scene, sorted, none, kDefaultEventTolerance);
   if (run.outputs.size() < sorted.size()) {  // the run failed before the last instant asked
     throw py::value_error("sol(t): the run again ended before t = " + std::to_string(sorted[run.outputs.size()]) +

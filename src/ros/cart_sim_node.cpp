@@ -71,6 +71,9 @@ CartSimNode::CartSimNode(ros::NodeHandle node, ros::NodeHandle private_node)
   node_.setCallbackQueue(&callback_queue_);
   private_node_.setCallbackQueue(&callback_queue_);
   publisher_.emplace(node_, private_node_, parameters_, run_->simulation().scene().initial_state.time);
+  start_part<std::invalid_argument>("bad parameter ~events: ", [&] {
+    events_.emplace(private_node_, parameters_.events, run_->simulation(), parameters_.frames.odom);
+  });
   pacing_.emplace(node_, parameters_, callback_queue_, work_, [this] { return stop_requested(); });
   commands_->subscribe(node_, [this](const std::string& topic, double time, const std_msgs::Float64& message) {
     record_command(topic, time, message);
@@ -112,6 +115,7 @@ bool CartSimNode::restart_run(const std::string& source, RunStart start, const s
     return false;
   }
   run_->guard().reset();
+  events_->restart();  // the events' occurrences count again from the new start
   ++restarts_;  // a batch in progress stops: its publish instants belonged to the old start
   const double time = run_->simulation().state().time;
   commands_->restart(time);
@@ -200,6 +204,13 @@ bool CartSimNode::take_step() {
   }
   step_requests_->count_step(run_->simulation().state().time);
   work_.count_step(run_->simulation().state().time - time_before);
+  if (events_->after_step(record_ ? &*record_ : nullptr)) {  // a terminal event: the node pauses here
+    paused_ = true;
+    const double time = run_->simulation().state().time;
+    pacing_->deadlines().restart(Clock::now(), time);
+    step_requests_->cancel("a terminal event", time);
+    ROS_INFO("cart_sim: paused at t = %s s by a terminal event (~pause false goes on)", format_seconds(time).c_str());
+  }
   const Simulation& simulation = run_->simulation();
   if (instants_->first_clock_due(simulation.scene().initial_state.time, simulation.state().time,
                                  0.5 * simulation.step_size(), simulation.at_end())) {

@@ -6,7 +6,12 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <XmlRpcValue.h>
+
+#include <algorithm>
+
 #include "birkhoff_cart/core/integrators/integrator_settings.h"
+#include "birkhoff_cart/core/run/state_events.h"
 #include "birkhoff_cart/ros/bag_recorder.h"
 #include "birkhoff_cart/ros/parameter_reading.h"
 
@@ -239,6 +244,33 @@ const std::vector<ParameterRow>& parameter_rows() {
       {"start_paused",
        [](Node p, Parameters parameters) {
          parameters.start_paused = read_parameter<bool>(p, "start_paused", parameters.start_paused);
+       }},
+      {"events",
+       [](Node p, Parameters parameters) {
+         // A list of event texts, or one string of them separated by ';' (roslaunch's events:=...).
+         XmlRpc::XmlRpcValue value;
+         if (p.getParam("events", value) && value.getType() == XmlRpc::XmlRpcValue::TypeString) {
+           const std::string given = static_cast<std::string>(value);
+           std::string::size_type from = 0;
+           parameters.events.clear();
+           while (from <= given.size()) {
+             const std::string::size_type end = std::min(given.find(';', from), given.size());
+             std::string text = given.substr(from, end - from);
+             text.erase(0, text.find_first_not_of(" \t"));
+             text.erase(text.find_last_not_of(" \t") + 1);
+             if (!text.empty()) parameters.events.push_back(text);
+             from = end + 1;
+           }
+         } else {
+           parameters.events = read_parameter<std::vector<std::string>>(p, "events", parameters.events);
+         }
+         for (const std::string& text : parameters.events) {
+           try {
+             state_field_event(text);
+           } catch (const std::invalid_argument& error) {
+             throw std::invalid_argument("parameter " + p.resolveName("events") + ": " + error.what());
+           }
+         }
        }},
       {"diagnostic_period",
        [](Node p, Parameters parameters) {

@@ -29,23 +29,10 @@ std::string temp_path(const std::string& name) {
   return ::testing::TempDir() + "cli_robustness_" + std::to_string(getpid()) + "_" + name;
 }
 
-struct Outcome {
-  int exit_status = -1;  ///< 124: killed by timeout; 128 + n: died of signal n
-  std::string standard_output, standard_error;
-};
+using Outcome = birkhoff_cart_test::CliPrinted;
 
 Outcome run(const std::string& arguments) {
-  const std::string out = temp_path("stdout.txt"), err = temp_path("stderr.txt");
-  const std::string command = "timeout " + std::to_string(kRunBudget) + " '" + cart_simulate_path() + "' " +
-                              arguments + " > '" + out + "' 2> '" + err + "'";
-  const int status = std::system(command.c_str());
-  Outcome outcome;
-  outcome.exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  outcome.standard_output = read_file(out);
-  outcome.standard_error = read_file(err);
-  std::remove(out.c_str());
-  std::remove(err.c_str());
-  return outcome;
+  return birkhoff_cart_test::run_cart_simulate_printing(arguments, temp_path(""), kRunBudget);
 }
 
 /// free_coast starting at `start_time` [s] (spelled as in YAML), written to a temporary file.

@@ -119,4 +119,28 @@ inline CliOutcome run_cart_simulate(const std::string& arguments, const std::str
   return outcome;
 }
 
+/// What a cart_simulate run printed: its exit status (−1 when it died of a signal), stdout and stderr.
+struct CliPrinted {
+  int exit_status = -1;  ///< 124: killed by timeout
+  std::string standard_output, standard_error;
+};
+
+/// Runs cart_simulate through the shell with `arguments` (shell-quoted by the caller), under
+/// `timeout time_limit` when it is > 0 [s], capturing stdout and stderr through the files
+/// `scratch` + "stdout.txt" and + "stderr.txt", which are removed afterwards.
+inline CliPrinted run_cart_simulate_printing(const std::string& arguments, const std::string& scratch,
+                                            int time_limit = 0) {
+  const std::string out = scratch + "stdout.txt", err = scratch + "stderr.txt";
+  const std::string command = (time_limit > 0 ? "timeout " + std::to_string(time_limit) + " " : std::string()) + "'" +
+                              cart_simulate_path() + "' " + arguments + " > '" + out + "' 2> '" + err + "'";
+  const int status = std::system(command.c_str());
+  CliPrinted printed;
+  printed.exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  printed.standard_output = read_file(out);
+  printed.standard_error = read_file(err);
+  std::remove(out.c_str());
+  std::remove(err.c_str());
+  return printed;
+}
+
 }  // namespace birkhoff_cart_test

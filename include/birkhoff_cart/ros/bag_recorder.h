@@ -36,6 +36,7 @@
 #include <std_msgs/Float64.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include "birkhoff_cart/CartEvent.h"
 #include "birkhoff_cart/IntegrationError.h"
 #include "birkhoff_cart/ros/bag_file_claim.h"
 #include "birkhoff_cart/ros/bag_file_writer.h"
@@ -69,7 +70,8 @@ class BagRecorder {
   enum class Compression { kNone, kLz4, kBz2 };
   /// The message types the node records (one slot of the ring holds any of them).
   using Message =
-      std::variant<nav_msgs::Odometry, sensor_msgs::JointState, IntegrationError, std_msgs::Float64, tf2_msgs::TFMessage>;
+      std::variant<nav_msgs::Odometry, sensor_msgs::JointState, IntegrationError, std_msgs::Float64, tf2_msgs::TFMessage,
+                   CartEvent>;
   /// Slots of the ring between the time loop and the writer thread [messages].
   static constexpr std::size_t kQueueCapacity = 1024;
   /// Messages queued before the waiting writer thread is woken (close() wakes it for the rest).

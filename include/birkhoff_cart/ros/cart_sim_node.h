@@ -57,6 +57,7 @@
 #include "birkhoff_cart/ros/cart_sim_reports.h"
 #include "birkhoff_cart/ros/command_inputs.h"
 #include "birkhoff_cart/ros/conversions.h"
+#include "birkhoff_cart/ros/event_reports.h"
 #include "birkhoff_cart/ros/instant_publisher.h"
 #include "birkhoff_cart/ros/lockstep_barrier.h"
 #include "birkhoff_cart/ros/pose_requests.h"
@@ -156,6 +157,7 @@ class CartSimNode {
   std::unique_ptr<GuardedRun> run_;
   std::optional<CommandInputs> commands_;  ///< steering_torque, drive_torque: channels, watchdogs, lockstep answers
   std::optional<RunRecord> record_;  ///< the bag of each run; none without ~bag_path
+  std::optional<EventReports> events_;  ///< ~events: crossings published on ~events; a terminal one pauses
 
   std::optional<InstantPublisher> publisher_;  ///< the topics of a publish instant, /clock, tf
   /// The scene's odometry sensor (docs/odometry_sensor.md); none: odom is the exact state.

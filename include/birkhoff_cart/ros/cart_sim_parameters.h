@@ -45,6 +45,7 @@ struct CartSimParameters {
   bool follow_clock = false;                 ///< ~follow_clock: step only up to another node's /clock
   bool start_paused = false;                 ///< ~start_paused: wait for ~pause(false) before stepping
   double diagnostic_period = 1.0;            ///< ~diagnostic_period: /diagnostics every [s of scene time]
+  std::vector<std::string> events;           ///< ~events: FIELD=VALUE[,rising|falling][,terminal] each (docs/events.md)
   // The accuracy guard's limits (~accuracy/<quantity> and the residual thresholds mapped onto it)
   // are read by ros_accuracy::load_requirements.
 };
