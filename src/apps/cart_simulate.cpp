@@ -417,19 +417,20 @@ class ProgressReport {
   Clock::time_point wall_start_, next_report_;
 };
 
-/// The --event options' events (given one per line), a UsageError naming a malformed one.
+/// The --event options' events (given one per line), a UsageError naming a malformed or repeated one.
 std::vector<birkhoff_cart::StateEvent> parse_events(const std::string& lines) {
-  std::vector<birkhoff_cart::StateEvent> events;
+  std::vector<std::string> texts;
   std::string::size_type from = 0;
   for (;;) {
     const std::string::size_type end = lines.find('\n', from);
-    try {
-      events.push_back(birkhoff_cart::state_field_event(lines.substr(from, end == std::string::npos ? end : end - from)));
-    } catch (const std::invalid_argument& error) {
-      throw UsageError(std::string("option --event: ") + error.what());
-    }
-    if (end == std::string::npos) return events;
+    texts.push_back(lines.substr(from, end == std::string::npos ? end : end - from));
+    if (end == std::string::npos) break;
     from = end + 1;
+  }
+  try {
+    return birkhoff_cart::state_field_events(texts);
+  } catch (const std::invalid_argument& error) {
+    throw UsageError(std::string("option --event: ") + error.what());
   }
 }
 

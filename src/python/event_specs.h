@@ -26,6 +26,11 @@ inline std::vector<EventSpec> read_event_specs(const pybind11::object& events) {
   std::vector<EventSpec> specs;
   if (events.is_none()) return specs;
   std::vector<py::object> given;
+  if (py::isinstance<py::str>(events) || py::isinstance<py::bytes>(events)) {
+    throw py::type_error("events must be a callable g(t, state) or a sequence of them, got the text " +
+                         std::string(py::repr(events)) +
+                         " (texts like 'chi=0.3,rising' are cart_simulate's --event and cart_sim's ~events)");
+  }
   if (PyCallable_Check(events.ptr())) {
     given.push_back(events);
   } else {

@@ -247,29 +247,32 @@ const std::vector<ParameterRow>& parameter_rows() {
        }},
       {"events",
        [](Node p, Parameters parameters) {
-         // A list of event texts, or one string of them separated by ';' (roslaunch's events:=...).
+         // A list of event texts, or one string of them separated by ';' (roslaunch's events:=...),
+         // each trimmed of spaces; a blank string is none, an empty event between ';' is refused.
          XmlRpc::XmlRpcValue value;
          if (p.getParam("events", value) && value.getType() == XmlRpc::XmlRpcValue::TypeString) {
            const std::string given = static_cast<std::string>(value);
-           std::string::size_type from = 0;
            parameters.events.clear();
-           while (from <= given.size()) {
-             const std::string::size_type end = std::min(given.find(';', from), given.size());
-             std::string text = given.substr(from, end - from);
-             text.erase(0, text.find_first_not_of(" \t"));
-             text.erase(text.find_last_not_of(" \t") + 1);
-             if (!text.empty()) parameters.events.push_back(text);
-             from = end + 1;
+           if (given.find_first_not_of(" \t") != std::string::npos) {
+             std::string::size_type from = 0;
+             while (from <= given.size()) {
+               const std::string::size_type end = std::min(given.find(';', from), given.size());
+               std::string text = given.substr(from, end - from);
+               text.erase(0, text.find_first_not_of(" \t"));
+               text.erase(text.find_last_not_of(" \t") + 1);
+               require(!text.empty(), "parameter " + p.resolveName("events") + ": an empty event in '" + given +
+                                          "' (events are separated by ';')");
+               parameters.events.push_back(text);
+               from = end + 1;
+             }
            }
          } else {
            parameters.events = read_parameter<std::vector<std::string>>(p, "events", parameters.events);
          }
-         for (const std::string& text : parameters.events) {
-           try {
-             state_field_event(text);
-           } catch (const std::invalid_argument& error) {
-             throw std::invalid_argument("parameter " + p.resolveName("events") + ": " + error.what());
-           }
+         try {
+           state_field_events(parameters.events);
+         } catch (const std::invalid_argument& error) {
+           throw std::invalid_argument("parameter " + p.resolveName("events") + ": " + error.what());
          }
        }},
       {"diagnostic_period",

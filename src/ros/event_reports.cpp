@@ -14,7 +14,7 @@ namespace birkhoff_cart {
 EventReports::EventReports(ros::NodeHandle& private_node, const std::vector<std::string>& texts,
                            Simulation& simulation, const std::string& frame_id)
     : simulation_(simulation), frame_id_(frame_id) {
-  for (const std::string& text : texts) events_.push_back(state_field_event(text));
+  events_ = state_field_events(texts);
   if (events_.empty()) return;
   locator_.emplace(simulation_, events_);  // refuses here, by the core's reason
   published_.assign(events_.size(), 0);

@@ -304,3 +304,15 @@ def test_at_fixed_steps_a_crossing_is_located_on_one_step_of_the_member_from_the
     # A scene whose actuators move with the run cannot be stepped beside it: refused by name.
     with pytest.raises(ValueError, match="events at fixed steps: .*actuators"):
         simulator.solve(scene("steering_actuator"), events=y_passes)
+
+
+def test_a_text_is_no_event_function():
+    # Texts like 'chi=0.1' are the CLI's and the node's events; solve() takes callables (it would
+    # otherwise iterate the text letter by letter).
+    with pytest.raises(TypeError, match="got the text 'chi=0.1'"):
+        simulator.solve(scene("paper_special", GAUSS8_ADAPTIVE), events="chi=0.1")
+
+
+def test_a_g_that_stays_at_zero_has_no_crossing():
+    result = simulator.solve(scene("paper_special", GAUSS8_ADAPTIVE), events=lambda t, state: 0.0)
+    assert result.status == 0 and result.t_events[0].size == 0

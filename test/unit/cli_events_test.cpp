@@ -109,6 +109,11 @@ TEST(CartSimulateEvents, BadEventsAreRefusedByName) {
       run_cli("--scene '" + scene_path("steering_actuator") + "' --event chi=0.3 --output '" + output + "'");
   EXPECT_EQ(actuated.exit_status, 3);
   EXPECT_NE(actuated.standard_error.find("events at fixed steps"), std::string::npos) << actuated.standard_error;
+  EXPECT_NE(actuated.standard_error.find("dopri5"), std::string::npos) << "no way out named: " << actuated.standard_error;
+  const Outcome twice = run_cli("--scene '" + scene_path("paper_special") +
+                                "' --event chi=2 --event chi=2 --output '" + output + "'");
+  EXPECT_EQ(twice.exit_status, 2);
+  EXPECT_NE(twice.standard_error.find("given twice"), std::string::npos) << twice.standard_error;
   std::remove(output.c_str());
 }
 

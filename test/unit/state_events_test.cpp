@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -153,6 +154,49 @@ TEST(EventLocator, ResumeRecordsTheCrossingsHeldAfterATerminalOne) {
     ASSERT_EQ(events[1].times.size(), 1u) << control;
     EXPECT_NEAR(events[1].times[0], 2.003, 1e-10) << control;
     EXPECT_EQ(events[0].times.size(), 1u) << control;
+  }
+}
+
+TEST(EventLocator, AZeroReachedAtAStepsEndIsOneCrossingAndAZeroHeldIsNone) {
+  // The state's time lands on t0 + n h exactly: t = that time is reached at a step's end.
+  Simulation probe(paper_special("birkhoff_gauss8", "fixed"));
+  for (int n = 0; n < 20; ++n) probe.step();
+  char text[64];
+  std::snprintf(text, sizeof text, "t=%.17g", probe.state().time);
+  Simulation simulation(paper_special("birkhoff_gauss8", "fixed"));
+  std::vector<StateEvent> events = {state_field_event(text), state_field_event(std::string(text) + ",rising")};
+  StateEvent held;  // zero all along
+  held.name = "held";
+  held.g = [](const CartState&) { return 0.0; };
+  events.push_back(held);
+  EventLocator locator(simulation, events);
+  run_with_events(simulation, locator);
+  ASSERT_EQ(events[0].times.size(), 1u) << text;
+  EXPECT_EQ(events[0].times[0], probe.state().time);
+  EXPECT_EQ(events[1].times.size(), 1u);
+  EXPECT_TRUE(events[2].times.empty()) << events[2].times.size() << " crossings of a g that stays at zero";
+}
+
+TEST(StateFieldEvents, RefuseATextGivenTwiceAndShowLongOrControlTextsBounded) {
+  EXPECT_EQ(state_field_events({"chi=0.1", "chi=0.1,rising"}).size(), 2u);
+  try {
+    state_field_events({"chi=0.1", "x=2", "chi=0.1"});
+    ADD_FAILURE() << "a repeated event was taken";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("event 'chi=0.1' given twice"), std::string::npos) << error.what();
+  }
+  EXPECT_EQ(state_field_event("chi=1e-320").g(CartState{}), -1e-320);  // a subnormal is a number
+  try {
+    state_field_event(std::string(5000, 'q') + "\x01=1");
+    ADD_FAILURE();
+  } catch (const std::invalid_argument& error) {
+    EXPECT_LT(std::string(error.what()).size(), 400u) << error.what();
+  }
+  try {
+    state_field_event("ch\ti=1");
+    ADD_FAILURE();
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("'ch\\x09i=1'"), std::string::npos) << error.what();
   }
 }
 

@@ -36,9 +36,29 @@ double state_field(const CartState& state, const std::string& field) {
   throw std::invalid_argument("unknown state field '" + field + "' (one of " + known + ")");
 }
 
+namespace {
+
+/// `text` as a message shows it: control bytes as \xNN, at most 60 bytes (then "…").
+std::string shown(const std::string& text) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size() && i < 60; ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    if (c < 0x20 || c == 0x7f) {
+      static const char* const kHex = "0123456789abcdef";
+      out += std::string("\\x") + kHex[c >> 4] + kHex[c & 15];
+    } else {
+      out += text[i];
+    }
+  }
+  if (text.size() > 60) out += "…";
+  return out;
+}
+
+}  // namespace
+
 StateEvent state_field_event(const std::string& text) {
   const auto refuse = [&](const std::string& problem) {
-    return std::invalid_argument("event '" + text + "': " + problem +
+    return std::invalid_argument("event '" + shown(text) + "': " + problem +
                                  " (FIELD=VALUE[,rising|falling][,terminal], e.g. chi=0.3,rising,terminal)");
   };
   std::vector<std::string> parts;
@@ -53,16 +73,17 @@ StateEvent state_field_event(const std::string& text) {
   if (equals == std::string::npos) throw refuse("no '=' between the field and its value");
   const std::string field = parts[0].substr(0, equals);
   const std::string value_text = parts[0].substr(equals + 1);
-  try {
-    state_field(CartState{}, field);
-  } catch (const std::invalid_argument& error) {
-    throw refuse(error.what());
+  if (std::find(event_field_names().begin(), event_field_names().end(), field) == event_field_names().end()) {
+    std::string known;
+    for (const std::string& name : event_field_names()) known += (known.empty() ? "" : ", ") + name;
+    throw refuse("unknown state field '" + shown(field) + "' (one of " + known + ")");
   }
   char* end = nullptr;
   errno = 0;
   const double value = value_text.empty() ? 0.0 : std::strtod(value_text.c_str(), &end);
-  if (value_text.empty() || end != value_text.c_str() + value_text.size() || errno == ERANGE || !std::isfinite(value)) {
-    throw refuse("the value '" + value_text + "' is no finite number");
+  const bool overflow = errno == ERANGE && std::abs(value) > 1.0;  // an underflow to a subnormal is a number
+  if (value_text.empty() || end != value_text.c_str() + value_text.size() || overflow || !std::isfinite(value)) {
+    throw refuse("the value '" + shown(value_text) + "' is no finite number");
   }
   StateEvent event;
   event.name = text;
@@ -78,10 +99,23 @@ StateEvent state_field_event(const std::string& text) {
       if (event.terminal_after != 0) throw refuse("'terminal' twice");
       event.terminal_after = 1;
     } else {
-      throw refuse("unknown flag '" + flag + "' (rising, falling or terminal)");
+      throw refuse("unknown flag '" + shown(flag) + "' (rising, falling or terminal)");
     }
   }
   return event;
+}
+
+std::vector<StateEvent> state_field_events(const std::vector<std::string>& texts) {
+  std::vector<StateEvent> events;
+  for (std::size_t i = 0; i < texts.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      if (texts[j] == texts[i]) {
+        throw std::invalid_argument("event '" + shown(texts[i]) + "' given twice (each crossing would be reported twice)");
+      }
+    }
+    events.push_back(state_field_event(texts[i]));
+  }
+  return events;
 }
 
 EventLocator::EventLocator(const Simulation& simulation, std::vector<StateEvent>& events, double time_tolerance,
@@ -98,7 +132,9 @@ EventLocator::EventLocator(const Simulation& simulation, std::vector<StateEvent>
       const double next = std::min(before_.time + 0.5 * simulation.step_size(), simulation.end_time());
       simulation.state_by_one_step(before_, next);
     } catch (const std::logic_error& error) {
-      throw std::invalid_argument(std::string("events at fixed steps: ") + error.what());
+      throw std::invalid_argument(std::string("events at fixed steps: ") + error.what() +
+                                  "; dopri5 (integrator dopri5: its own steps, with a dense output) locates "
+                                  "them on any scene");
     }
   }
   for (const StateEvent& event : events_) g_before_.push_back(value(event, before_));
@@ -136,10 +172,12 @@ bool EventLocator::step_to(const CartState& stepped_to) {
     g_after[i] = value(event, after);
     const double g0 = g_before_[i];
     const double g1 = g_after[i];
-    const bool up = g0 <= 0.0 && g1 >= 0.0;
-    const bool down = g0 >= 0.0 && g1 <= 0.0;  // solve_ivp's rule
+    // g reaches zero or passes it. A step that starts at zero is none: that zero was the run's start,
+    // or the end of the step that reached it (counted there once), and a g that stays at zero never
+    // crosses (integrate()'s rule, system_integration.h).
+    const bool up = g0 < 0.0 && g1 >= 0.0;
+    const bool down = g0 > 0.0 && g1 <= 0.0;
     if (!(event.direction > 0.0 ? up : event.direction < 0.0 ? down : up || down)) continue;
-    if (g0 == 0.0 && first_step_) continue;  // zero at the start: no crossing
     CartState at = after;
     double time = after.time;  // [s]
     if (state_in_step(0.5 * (before_.time + after.time), at)) {
@@ -165,7 +203,6 @@ bool EventLocator::step_to(const CartState& stepped_to) {
   }
   g_before_ = g_after;
   before_ = after;
-  first_step_ = false;
   std::stable_sort(found.begin(), found.end(), [](const Found& a, const Found& b) { return a.time < b.time; });
   record(found);
   return stopped_;

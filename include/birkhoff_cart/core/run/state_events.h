@@ -44,6 +44,9 @@ double state_field(const CartState& state, const std::string& field);
 /// at its first crossing). std::invalid_argument naming the text and what is wrong with it.
 StateEvent state_field_event(const std::string& text);
 
+/// The events of several texts, each as state_field_event(); a text given twice is refused by name.
+std::vector<StateEvent> state_field_events(const std::vector<std::string>& texts);
+
 /// Finds the events' crossings step by step and stops at a terminal one.
 class EventLocator {
  public:
@@ -61,7 +64,8 @@ class EventLocator {
   /// The run went on from the state of the last call (or of the construction) to `after`: the
   /// member's newest own step, or a step of the schedule at fixed steps. Records the crossings in
   /// it in time order up to a terminal one; true when a terminal one stopped it (then stop_state(),
-  /// stopping_event()). A g zero at the run's start is no crossing. An own step beyond the run's
+  /// stopping_event()). A crossing is where g reaches zero or passes it: a step that starts at zero
+  /// has none (the run's start, or the end of the step that reached it, which counted it once). An own step beyond the run's
   /// end is read up to the end. After a stop it goes on locating, and holds the crossings it finds
   /// (those of the stopping step after the terminal one too) until resume(); it returns true until then.
   bool step_to(const CartState& after);
@@ -96,7 +100,6 @@ class EventLocator {
   bool own_steps_;
   CartState before_;
   std::vector<double> g_before_;
-  bool first_step_ = true;
   bool stopped_ = false;
   CartState stop_state_;
   std::size_t stopping_event_ = 0;
