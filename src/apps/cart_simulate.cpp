@@ -3,7 +3,7 @@
 //   cart_simulate --scene FILE [--integrator NAME] [--step H] [--tolerance TOL] [--duration T]
 //                 [--output-rate HZ] [--birkhoffian-form F] [--quiet] [--step-control C]
 //                 [--position-tolerance M] [--on-accuracy-error fail|warn] [--random-scene SEED:K]
-//                 [--event FIELD=VALUE[,rising|falling][,terminal]]...
+//                 [--event FIELD=VALUE[,rising|falling][,terminal]]... [--events-output FILE.csv]
 //                 --output FILE.csv   (also --option=value)
 //   cart_simulate --help | -h | --version
 //   cart_simulate --list-integrators [--json]
@@ -181,7 +181,8 @@ std::string usage() {
          "                     [--step-control " + alternatives(birkhoff_cart::step_control_names(), "|", "|") +
          "] [--position-tolerance M]\n"
          "                     [--on-accuracy-error fail|warn] [--random-scene SEED:K]\n"
-         "                     [--event FIELD=VALUE[,rising|falling][,terminal]]... --output FILE.csv\n"
+         "                     [--event FIELD=VALUE[,rising|falling][,terminal]]... [--events-output FILE.csv]\n"
+         "                     --output FILE.csv\n"
          "       cart_simulate --help | -h | --version\n"
          "       cart_simulate --list-integrators [--json]   (the table below; --json: for programs)\n"
          "  --scene FILE            scene YAML (config/scenes/*.yaml); it provides every default\n"
@@ -207,6 +208,8 @@ std::string usage() {
          "                          falling or both; terminal stops the run there). Repeatable. Each crossing,\n"
          "                          located on the member's own step to 1e-12 s, is a line 'event ...' on\n"
          "                          stdout (docs/events.md)\n"
+         "  --events-output FILE.csv  the crossings also as CSV: event,occurrence,t,x,y,theta,chi,phi1..phi4,\n"
+         "                          pi1,omega1,omega2 (SI units, in time order)\n"
          "  --on-accuracy-error A   fail (default: exit 5 when the scene's accuracy guard reaches ERROR)\n"
          "                          or warn (exit 0; the summary still names the quantity)\n"
          "  --output FILE.csv       where to write t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2,energy,p2,\n"
@@ -251,7 +254,7 @@ std::map<std::string, std::string> parse_arguments(int argc, char** argv) {
   static const char* const kOptions[] = {"--scene",       "--integrator",       "--step",  "--tolerance",
                                          "--duration",    "--output-rate",      "--birkhoffian-form", "--output",
                                          "--on-accuracy-error", "--step-control", "--random-scene",
-                                         "--position-tolerance", "--event"};
+                                         "--position-tolerance", "--event", "--events-output"};
   std::map<std::string, std::string> values;
   for (int i = 1; i < argc; ++i) {
     std::string option = argv[i];
@@ -443,6 +446,29 @@ bool close_output(std::FILE* file) {
   return !write_failed && !close_failed;
 }
 
+/// The crossings as CSV rows in time order: event (its text, quoted), occurrence (1, 2, … per event),
+/// t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2 (SI, %.17g); closes the file.
+void write_event_rows(std::FILE* file, const std::vector<birkhoff_cart::StateEvent>& events) {
+  struct Row {
+    double time;  // [s]
+    std::size_t event, occurrence;
+  };
+  std::vector<Row> rows;
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    for (std::size_t k = 0; k < events[i].times.size(); ++k) rows.push_back({events[i].times[k], i, k});
+  }
+  std::stable_sort(rows.begin(), rows.end(), [](const Row& a, const Row& b) { return a.time < b.time; });
+  std::fprintf(file, "event,occurrence,t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2\n");
+  for (const Row& row : rows) {
+    const CartState& s = events[row.event].states[row.occurrence];
+    std::fprintf(file, "\"%s\",%zu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
+                 events[row.event].name.c_str(), row.occurrence + 1, row.time, s.x, s.y, s.heading, s.steering_angle,
+                 s.wheel_spin_angle[0], s.wheel_spin_angle[1], s.wheel_spin_angle[2], s.wheel_spin_angle[3],
+                 s.arc_length, s.forward_speed, s.steering_rate);
+  }
+  if (!close_output(file)) std::fprintf(stderr, "cart_simulate: writing the events' CSV failed: %s\n", std::strerror(errno));
+}
+
 int run(int argc, char** argv) {
   if (asks_for_help(argc, argv)) {
     std::fputs(usage().c_str(), stdout);
@@ -460,6 +486,9 @@ int run(int argc, char** argv) {
     if (arguments.count("--random-scene")) scene = random_scene(arguments.at("--random-scene"), scene);
     apply_overrides(arguments, scene);
     if (arguments.count("--event")) events = parse_events(arguments.at("--event"));
+    if (arguments.count("--events-output") && events.empty()) {
+      throw UsageError("option --events-output needs at least one --event");
+    }
   } catch (const UsageError& error) {
     std::fprintf(stderr, "cart_simulate: %s\n%s", error.what(), usage().c_str());
     return kExitUsage;
@@ -489,6 +518,16 @@ int run(int argc, char** argv) {
   if (!file) {
     std::fprintf(stderr, "cart_simulate: cannot write '%s': %s\n", output_path.c_str(), std::strerror(errno));
     return kExitSettings;
+  }
+  std::FILE* events_file = nullptr;  // --events-output: the crossings as CSV, written at the end
+  if (arguments.count("--events-output")) {
+    events_file = std::fopen(arguments.at("--events-output").c_str(), "w");
+    if (!events_file) {
+      std::fprintf(stderr, "cart_simulate: cannot write '%s': %s\n", arguments.at("--events-output").c_str(),
+                   std::strerror(errno));
+      std::fclose(file);
+      return kExitSettings;
+    }
   }
   const Simulation& simulation = guarded_run->simulation();
   std::optional<birkhoff_cart::OdometrySensor> sensor;
@@ -538,6 +577,7 @@ int run(int argc, char** argv) {
     }
     std::stable_sort(lines.begin(), lines.end(), [](const Line& a, const Line& b) { return a.time < b.time; });
     for (const Line& line : lines) std::printf("event %s\n", line.text.c_str());
+    if (events_file) write_event_rows(events_file, events);
     if (locator && locator->stopped()) {
       std::printf("cart_simulate: stopped by the terminal event %s at t = %.17g s (the run stopped at the first "
                   "step that reached it, t = %.17g s; no row after the event)\n",

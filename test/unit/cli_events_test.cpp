@@ -50,9 +50,10 @@ const std::string kGauss8Fixed = " --integrator birkhoff_gauss8 --step 0.01 --qu
 TEST(CartSimulateEvents, CrossingsArePrintedAtTheClosedFormsTimesAndLeaveTheRowsAsTheyWere) {
   const std::string watched = temp_path("watched.csv");
   const std::string plain = temp_path("plain.csv");
+  const std::string rows = temp_path("events.csv");
   const Outcome outcome = run_cli("--scene '" + scene_path("paper_special") + "'" + kGauss8Fixed +
-                                  " --event chi=2.5 --event pi1=1.2,rising --event=chi=2.5,falling --output '" +
-                                  watched + "'");
+                                  " --event chi=2.5 --event pi1=1.2,rising --event=chi=2.5,falling --events-output '" +
+                                  rows + "' --output '" + watched + "'");
   ASSERT_EQ(outcome.exit_status, 0) << outcome.standard_error;
   const auto events = event_lines(outcome.standard_output);
   ASSERT_EQ(events.size(), 2u) << outcome.standard_output;
@@ -61,6 +62,19 @@ TEST(CartSimulateEvents, CrossingsArePrintedAtTheClosedFormsTimesAndLeaveTheRows
   EXPECT_EQ(events[1].first, "chi=2.5");
   EXPECT_NEAR(events[1].second, 2.5, 1e-10);
   EXPECT_NE(outcome.standard_output.find("cart_simulate summary"), std::string::npos);
+  // The same crossings as CSV rows, in time order, with the state there (chi = t on the paper's case).
+  std::istringstream csv(read_file(rows));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "event,occurrence,t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2");
+  for (const auto& [name, time] : events) {
+    ASSERT_TRUE(std::getline(csv, line));
+    EXPECT_EQ(line.rfind("\"" + name + "\",1,", 0), 0u) << line;
+    const std::size_t t_at = line.find(",1,") + 3;
+    EXPECT_EQ(std::strtod(line.c_str() + t_at, nullptr), time) << line;
+  }
+  EXPECT_FALSE(std::getline(csv, line)) << line;
+  std::remove(rows.c_str());
   ASSERT_EQ(run_cli("--scene '" + scene_path("paper_special") + "'" + kGauss8Fixed + " --output '" + plain + "'")
                 .exit_status,
             0);
