@@ -449,20 +449,11 @@ bool close_output(std::FILE* file) {
 /// The crossings as CSV rows in time order: event (its text, quoted), occurrence (1, 2, … per event),
 /// t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2 (SI, %.17g); closes the file.
 void write_event_rows(std::FILE* file, const std::vector<birkhoff_cart::StateEvent>& events) {
-  struct Row {
-    double time;  // [s]
-    std::size_t event, occurrence;
-  };
-  std::vector<Row> rows;
-  for (std::size_t i = 0; i < events.size(); ++i) {
-    for (std::size_t k = 0; k < events[i].times.size(); ++k) rows.push_back({events[i].times[k], i, k});
-  }
-  std::stable_sort(rows.begin(), rows.end(), [](const Row& a, const Row& b) { return a.time < b.time; });
   std::fprintf(file, "event,occurrence,t,x,y,theta,chi,phi1,phi2,phi3,phi4,pi1,omega1,omega2\n");
-  for (const Row& row : rows) {
-    const CartState& s = events[row.event].states[row.occurrence];
+  for (const birkhoff_cart::Occurrence& row : birkhoff_cart::occurrences_in_time_order(events)) {
+    const CartState& s = events[row.event].states[row.index];
     std::fprintf(file, "\"%s\",%zu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
-                 events[row.event].name.c_str(), row.occurrence + 1, row.time, s.x, s.y, s.heading, s.steering_angle,
+                 events[row.event].name.c_str(), row.index + 1, row.time, s.x, s.y, s.heading, s.steering_angle,
                  s.wheel_spin_angle[0], s.wheel_spin_angle[1], s.wheel_spin_angle[2], s.wheel_spin_angle[3],
                  s.arc_length, s.forward_speed, s.steering_rate);
   }
@@ -565,18 +556,9 @@ int run(int argc, char** argv) {
     }
   }
   const auto print_events = [&] {
-    struct Line {
-      double time;  // [s]
-      std::string text;
-    };
-    std::vector<Line> lines;
-    for (const birkhoff_cart::StateEvent& event : events) {
-      for (std::size_t k = 0; k < event.times.size(); ++k) {
-        lines.push_back({event.times[k], birkhoff_cart::describe_occurrence(event, k)});
-      }
+    for (const birkhoff_cart::Occurrence& occurrence : birkhoff_cart::occurrences_in_time_order(events)) {
+      std::printf("event %s\n", birkhoff_cart::describe_occurrence(events[occurrence.event], occurrence.index).c_str());
     }
-    std::stable_sort(lines.begin(), lines.end(), [](const Line& a, const Line& b) { return a.time < b.time; });
-    for (const Line& line : lines) std::printf("event %s\n", line.text.c_str());
     if (events_file) write_event_rows(events_file, events);
     if (locator && locator->stopped()) {
       std::printf("cart_simulate: stopped by the terminal event %s at t = %.17g s (the run stopped at the first "

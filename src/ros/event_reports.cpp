@@ -2,6 +2,7 @@
 #include "birkhoff_cart/ros/event_reports.h"
 
 #include <algorithm>
+#include <utility>
 #include <stdexcept>
 
 #include <ros/console.h>
@@ -51,12 +52,7 @@ bool EventReports::after_step(RunRecord* record) {
   // A member with its own steps may have found a crossing ahead of the run's time (its own step
   // reaches beyond the step of the schedule): it is published, and pauses, once the run gets there.
   const double now = simulation_.state().time;  // [s]
-  struct Occurrence {
-    double time;  // [s]
-    std::size_t event;
-    std::size_t index;
-  };
-  std::vector<Occurrence> fresh;
+  std::vector<Occurrence> fresh;  // the crossings the run has reached and not yet published
   for (std::size_t i = 0; i < events_.size(); ++i) {
     const std::vector<double>& times = events_[i].times;
     for (; published_[i] < times.size() && times[published_[i]] <= now; ++published_[i]) {

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "birkhoff_cart/core/integrators/crossing.h"
 #include "birkhoff_cart/core/run/simulation.h"
@@ -166,12 +167,12 @@ bool EventLocator::step_to(const CartState& stepped_to) {
   const CartState& after = beyond_end ? clipped : stepped_to;
   if (!(after.time > before_.time)) return stopped_;  // no time passed: no step to look in
   std::vector<Found> found;
-  std::vector<double> g_after(events_.size());
+  g_after_.resize(events_.size());  // reused: no allocation per step
   for (std::size_t i = 0; i < events_.size(); ++i) {
     const StateEvent& event = events_[i];
-    g_after[i] = value(event, after);
+    g_after_[i] = value(event, after);
     const double g0 = g_before_[i];
-    const double g1 = g_after[i];
+    const double g1 = g_after_[i];
     // g reaches zero or passes it. A step that starts at zero is none: that zero was the run's start,
     // or the end of the step that reached it (counted there once), and a g that stays at zero never
     // crosses (integrate()'s rule, system_integration.h).
@@ -201,7 +202,7 @@ bool EventLocator::step_to(const CartState& stepped_to) {
     }
     found.push_back({time, i, at});
   }
-  g_before_ = g_after;
+  std::swap(g_before_, g_after_);
   before_ = after;
   std::stable_sort(found.begin(), found.end(), [](const Found& a, const Found& b) { return a.time < b.time; });
   record(found);
@@ -231,6 +232,16 @@ bool EventLocator::resume() {
   held.swap(pending_);
   record(held);
   return stopped_;
+}
+
+std::vector<Occurrence> occurrences_in_time_order(const std::vector<StateEvent>& events) {
+  std::vector<Occurrence> occurrences;
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    for (std::size_t k = 0; k < events[i].times.size(); ++k) occurrences.push_back({events[i].times[k], i, k});
+  }
+  std::stable_sort(occurrences.begin(), occurrences.end(),
+                   [](const Occurrence& a, const Occurrence& b) { return a.time < b.time; });
+  return occurrences;
 }
 
 std::string describe_occurrence(const StateEvent& event, std::size_t occurrence) {

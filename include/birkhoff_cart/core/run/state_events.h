@@ -100,6 +100,7 @@ class EventLocator {
   bool own_steps_;
   CartState before_;
   std::vector<double> g_before_;
+  std::vector<double> g_after_;  ///< step_to's buffer for g at the step's end
   bool stopped_ = false;
   CartState stop_state_;
   std::size_t stopping_event_ = 0;
@@ -107,6 +108,15 @@ class EventLocator {
   StepStatistics own_work_;
   StepStatistics* work_;
 };
+
+/// One recorded crossing: its time [s], the index of its event and its index among that event's.
+struct Occurrence {
+  double time;
+  std::size_t event;
+  std::size_t index;
+};
+/// Every recorded crossing of `events`, in time order (ties in the events' order).
+std::vector<Occurrence> occurrences_in_time_order(const std::vector<StateEvent>& events);
 
 /// "chi=0.3,rising at t = 1.2345678901234567 s: x = … m, y = … m, theta = … rad, chi = … rad,
 /// omega1 = … m/s, omega2 = … rad/s" (17 significant digits), one line without newline.
