@@ -180,7 +180,7 @@ std::string usage() {
          "                     [--duration T] [--output-rate HZ] [--birkhoffian-form F] [--quiet]\n"
          "                     [--step-control " + alternatives(birkhoff_cart::step_control_names(), "|", "|") +
          "] [--position-tolerance M]\n"
-         "                     [--on-accuracy-error fail|warn] [--random-scene SEED:K]\n"
+         "                     [--global-error-estimate] [--on-accuracy-error fail|warn] [--random-scene SEED:K]\n"
          "                     [--event FIELD=VALUE[,rising|falling][,terminal]]... [--events-output FILE.csv]\n"
          "                     --output FILE.csv\n"
          "       cart_simulate --help | -h | --version\n"
@@ -196,6 +196,9 @@ std::string usage() {
          "                          steps for --position-tolerance, rows at any --output-rate (docs/accuracy.md §4)\n"
          "  --position-tolerance M  " + reversible + " or " + adaptive +
          " step control: the position error [m] allowed at the horizon\n"
+         "  --global-error-estimate  " + adaptive + " step control, Gauss members: estimate the position error\n"
+         "                          of B the run gathers (a shadow run on doubled steps; the summary reports\n"
+         "                          it); about half the work again, the same steps (docs/accuracy.md §4.5)\n"
          "  --duration T            simulated time after the start [s], > 0\n"
          "  --output-rate HZ        output rows per simulated second [Hz], > 0\n"
          "  --birkhoffian-form F    " + alternatives(birkhoff_cart::birkhoffian_form_names(), ", ", " or ") + "\n"
@@ -264,9 +267,9 @@ std::map<std::string, std::string> parse_arguments(int argc, char** argv) {
       attached = option.substr(equals + 1);
       option.resize(equals);
     }
-    if (option == "--quiet") {
-      if (attached) throw UsageError("option --quiet takes no value, got '--quiet=" + *attached + "'");
-      if (values.count(option)) throw UsageError("option --quiet given twice");
+    if (option == "--quiet" || option == "--global-error-estimate") {  // flags without a value
+      if (attached) throw UsageError("option " + option + " takes no value, got '" + option + "=" + *attached + "'");
+      if (values.count(option)) throw UsageError("option " + option + " given twice");
       values[option] = "";
       continue;
     }
@@ -328,6 +331,7 @@ void apply_overrides(const std::map<std::string, std::string>& arguments, Scene&
           birkhoff_cart::parse_step_control(one_of(option, text, birkhoff_cart::step_control_names()));
     }
     if (option == "--position-tolerance") scene.integrator.position_tolerance = parse_positive(option, text);
+    if (option == "--global-error-estimate") scene.integrator.global_error_estimate = true;
     if (option == "--on-accuracy-error") one_of(option, text, {"fail", "warn"});
   }
   // Each tolerance means one thing and is refused where it would be ignored.
@@ -346,6 +350,10 @@ void apply_overrides(const std::map<std::string, std::string>& arguments, Scene&
   if (arguments.count("--position-tolerance") && !controlled) {
     throw UsageError("option --position-tolerance is the position error [m] for --step-control adaptive or "
                      "reversible; the run steps at fixed steps of --step H");
+  }
+  if (settings.global_error_estimate && settings.step_control != birkhoff_cart::StepControl::kAdaptive) {
+    throw UsageError("option --global-error-estimate follows the grid of --step-control adaptive; the run steps "
+                     "under '" + control + "'");
   }
   if (controlled && !(settings.position_tolerance > 0.0)) {
     throw UsageError("option --step-control " + control +

@@ -30,6 +30,7 @@
 #include "birkhoff_cart/core/support/version.h"
 #include "birkhoff_cart/core/run/guarded_run.h"
 #include "birkhoff_cart/core/run/state_events.h"
+#include "birkhoff_cart/core/integrators/richardson_shadow.h"
 #include "event_specs.h"
 #include "own_system_bindings.h"
 #include "scene_source.h"
@@ -224,6 +225,10 @@ py::dict statistics_dict(const StepStatistics& statistics) {
   counts["internal_steps"] = statistics.internal_steps;
   counts["local_error_estimate_max"] = statistics.local_error_estimate_max;
   counts["local_error_estimate_sum"] = statistics.local_error_estimate_sum;
+  // The adaptive control's global error estimate (docs/accuracy.md §4.5): NaN when not asked for.
+  counts["global_error_estimate"] = statistics.global_error_estimate;
+  counts["global_error_estimate_in_range"] =
+      global_error_estimate_in_range(statistics.global_error_paired_steps, statistics.global_error_stiffness);
   return counts;
 }
 

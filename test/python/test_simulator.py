@@ -124,6 +124,22 @@ def test_the_registry_is_the_cli_s():
     assert adaptive == {name for name in birkhoffian if name.startswith("birkhoff_gauss")} | {"dopri5"}
 
 
+def test_the_global_error_estimate_is_in_the_statistics_when_asked_for():
+    settings = dict(name="birkhoff_gauss6", step_size=0.1, step_control="adaptive", position_tolerance=1e-7)
+    plain = simulator.Simulation(short("jackknife_whirl", 4.0, **settings))
+    estimated = simulator.Simulation(short("jackknife_whirl", 4.0, global_error_estimate=True, **settings))
+    assert np.array_equal(plain.run(), estimated.run())  # the same steps and rows
+    assert math.isnan(plain.statistics()["global_error_estimate"])
+    assert not plain.statistics()["global_error_estimate_in_range"]
+    # The whirl's error at 1e-7 m is about 5e-10 m (accuracy.md §4.5): within the estimate's band.
+    assert 1e-11 < estimated.statistics()["global_error_estimate"] < 1e-8
+    assert estimated.statistics()["global_error_estimate_in_range"]
+    assert estimated.statistics()["rhs_evaluations"] > plain.statistics()["rhs_evaluations"]
+    with pytest.raises(simulator.SceneError) as raised:
+        short("jackknife_whirl", 4.0, name="birkhoff_gauss6", step_size=0.1, global_error_estimate=True)
+    assert raised.value.key == "integrator.global_error_estimate"
+
+
 @pytest.mark.parametrize("member", [member["name"] for member in simulator.integrators()])
 def test_every_member_runs_at_fixed_steps_and_under_each_control_it_takes(member):
     row = next(m for m in simulator.integrators() if m["name"] == member)

@@ -23,6 +23,7 @@
 #include "birkhoff_cart/core/integrators/gauss_collocation.h"
 #include "birkhoff_cart/core/scene/scene.h"
 #include "birkhoff_cart/core/run/simulation.h"
+#include "run_end.h"
 #include "test_scenes.h"
 
 namespace birkhoff_cart {
@@ -51,16 +52,8 @@ Scene configured(Scene scene, const std::string& member, StepControl control, do
   return scene;
 }
 
-struct RunEnd {
-  CartState end;
-  StepStatistics statistics;
-};
-
-RunEnd run(const Scene& scene) {
-  Simulation simulation(scene);
-  simulation.advance_output_to(simulation.end_time());
-  return {simulation.state(), simulation.statistics()};
-}
+using birkhoff_cart_test::RunEnd;
+RunEnd run(const Scene& scene) { return birkhoff_cart_test::run_to_end_time(scene); }
 
 /// dopri5 over the whole run at 1e-13: resolves 1e-10 m on every shipped scene (against 1e-12: the
 /// two agree to ≤ 3e-11 m, measured).

@@ -9,6 +9,11 @@
 // tolerance proportionality (tolerance_proportionality.h), so that the delivered error lands at the
 // tolerance rather than orders below it. The stage solve still stops at κ·τ·h (B.49).
 //
+// With global_error_estimate a Richardson shadow run on doubled steps (richardson_shadow.h,
+// docs/accuracy.md §4.5, eq. (A.6)) follows the grid and estimates the position error of B the run
+// has gathered: reported, not steering (the steps are the same with and without it). Its work counts
+// in the run's.
+//
 // Where the grid must land exactly rather than interpolate: the instants given to land_on() (the
 // run's end: Simulation passes it), the loads' kinks (Effect::next_kink_after: a step across a
 // kink loses the member's order; after one the stage history restarts), and, in a scene whose
@@ -20,6 +25,8 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <Eigen/Eigenvalues>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -30,6 +37,7 @@
 #include "controlled_cart_stepper.h"
 #include "step_checks.h"
 #include "birkhoff_cart/core/integrators/tolerance_proportionality.h"
+#include "birkhoff_cart/core/integrators/richardson_shadow.h"
 
 namespace birkhoff_cart {
 
@@ -51,10 +59,13 @@ class AdaptiveCartStepperAdapter final
   static constexpr int kMaxSideStepHalvings = 6;
 
  public:
-  AdaptiveCartStepperAdapter(const Stepper& stepper, const IntegratorSettings& settings, const CartModel& model,
-                             const EffectSet& effects)
+  /// `shadow_stepper`: the member as the global error estimate's shadow steps it (without its ê).
+  AdaptiveCartStepperAdapter(const Stepper& stepper, const Stepper& shadow_stepper, const IntegratorSettings& settings,
+                             const CartModel& model, const EffectSet& effects)
       : Base(model, effects, "adaptive"), effects_(&effects), control_(stepper, control_settings(settings)),
-        position_tolerance_(settings.position_tolerance) {}
+        shadow_stepper_(shadow_stepper), position_tolerance_(settings.position_tolerance),
+        global_error_estimate_(settings.global_error_estimate),
+        stage_change_per_unit_step_(control_.settings().stage_change_fraction * control_.settings().error_per_unit_step) {}
 
   bool symmetric() const override { return Stepper::kSymmetric; }
 
@@ -77,6 +88,52 @@ class AdaptiveCartStepperAdapter final
     control_.start(seed, state.time, first_step(seed, state.time, statistics));
     dense_.clear();
     dense_.push(control_.grid(), control_.time());
+    if (global_error_estimate_) {
+      // A new grid (the run's start, a command, a failed step, a new state): the shadow starts again
+      // at its point; the error read so far is kept.
+      carried_error_ += met_error_;
+      met_error_.setZero();
+      shadow_.start(control_.grid(), control_.time());
+    }
+  }
+
+  /// The shadow follows the grid's accepted step that ended at the grid's time (`closes`: on a point
+  /// the grid had to land on; `after_kink`: a kink of the loads there); where it meets the grid, the
+  /// estimate (A.6) is read into `statistics`.
+  void follow_with_shadow(bool closes, bool after_kink, StepStatistics& statistics) {
+    StepStatistics shadow_work;  // its work counts in the run's; its ê (none) is not the run's
+    const auto met = shadow_.follow(
+        system_, shadow_stepper_, control_.grid(), control_.time(), closes, after_kink, stage_change_per_unit_step_,
+        [this](const auto& before, const auto& after, double t, double h) {
+          return stepper_checks::energy_balance_holds(system_.model(), cart_state(before, t), cart_state(after, t + h));
+        },
+        shadow_work);
+    statistics.rhs_evaluations += shadow_work.rhs_evaluations;
+    statistics.passive_evaluations += shadow_work.passive_evaluations;
+    statistics.newton_iterations_total += shadow_work.newton_iterations_total;
+    statistics.global_error_paired_steps = shadow_.paired_steps();
+    statistics.global_error_failed_steps = shadow_.failed_steps();
+    using Follow = typename RichardsonShadow<Stepper, System, Carried>::Follow;
+    if (met == Follow::kResynchronised) {
+      carried_error_ += met_error_;
+      met_error_.setZero();
+    }
+    if (met != Follow::kMet) return;
+    const double t = control_.time();  // [s]
+    // h·ρ(J) of the shadow's step: beyond ~1 a mode is stepped over, outside (A.6)'s asymptotic range.
+    const auto& memory = control_.grid().memory;
+    if (memory.jacobian_valid) {
+      const Eigen::EigenSolver<std::decay_t<decltype(memory.jacobian)>> modes(memory.jacobian, false);
+      const double stiffness = shadow_.last_step() * modes.eigenvalues().cwiseAbs().maxCoeff();  // [-]
+      if (std::isfinite(stiffness)) {
+        statistics.global_error_stiffness = std::max(statistics.global_error_stiffness, stiffness);
+      }
+    }
+    const CartState grid = cart_state(control_.grid().point, t);
+    const CartState shadow = cart_state(shadow_.shadow().point, t);
+    met_error_ = Eigen::Vector2d(grid.x - shadow.x, grid.y - shadow.y) / richardson_divisor<Stepper>();  // (A.6) [m]
+    statistics.global_error_estimate = (carried_error_ + met_error_).norm();
+    statistics.global_error_estimate_time = t;
   }
 
   /// h₀ = 0.01·max(‖x‖, 10⁻³)/‖(ż, ẏ)‖ in ê's weights (after Hairer–Nørsett–Wanner's first guess,
@@ -116,10 +173,12 @@ class AdaptiveCartStepperAdapter final
       control_.step(system_, limit, statistics, [this](const auto& before, const auto& after, double t, double h) {
         return stepper_checks::energy_balance_holds(system_.model(), cart_state(before, t), cart_state(after, t + h));
       });
-      if (at_kink && control_.time() == kink) {
+      const bool after_kink = at_kink && control_.time() == kink;
+      if (after_kink) {
         control_.forget_stage_history();
         dense_.clear();
       }
+      if (global_error_estimate_) follow_with_shadow(control_.time() == limit, after_kink, statistics);
       dense_.push(control_.grid(), control_.time());
       this->notify_grid(control_.grid(), control_.time());
     }
@@ -179,7 +238,13 @@ class AdaptiveCartStepperAdapter final
 
   const EffectSet* effects_;
   Control control_;
+  Stepper shadow_stepper_;  ///< the member without its ê, for the shadow
   double position_tolerance_;  ///< [m]
+  bool global_error_estimate_;
+  double stage_change_per_unit_step_;  ///< κ·τ: the stage solve stops at this·h [1/s] (B.49)
+  RichardsonShadow<Stepper, System, Carried> shadow_;
+  Eigen::Vector2d carried_error_ = Eigen::Vector2d::Zero();  ///< estimate kept over the shadow's restarts [m]
+  Eigen::Vector2d met_error_ = Eigen::Vector2d::Zero();      ///< (A.6) at the last meeting since then [m]
 };
 
 }  // namespace birkhoff_cart

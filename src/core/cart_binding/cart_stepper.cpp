@@ -22,6 +22,10 @@ std::unique_ptr<CartStepper> make_cart_stepper(const IntegratorSettings& setting
   if (!(settings.newton_tolerance > 0.0) || !std::isfinite(settings.newton_tolerance)) {
     throw std::invalid_argument("newton_tolerance must be finite and > 0");
   }
+  if (settings.global_error_estimate && settings.step_control != StepControl::kAdaptive) {
+    throw std::invalid_argument(std::string("global_error_estimate follows the grid of step_control 'adaptive', not '") +
+                                to_string(settings.step_control) + "'");
+  }
   if (settings.step_control == StepControl::kReversible) {
     const IntegratorEntry* member = find_integrator(settings.name);
     if (member == nullptr || !member->reversible()) {

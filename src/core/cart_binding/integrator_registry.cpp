@@ -80,12 +80,15 @@ template <class Stepper>
 std::unique_ptr<CartStepper> adaptive_step(const IntegratorSettings& settings, const CartModel& model,
                                            const EffectSet& effects) {
   const Stepper stepper = estimating_stepper<Stepper>(settings);
+  IntegratorSettings shadow = settings;  // the global error estimate's shadow reads no ê
+  shadow.local_error_estimate = false;
+  const Stepper shadow_stepper = configured_stepper<Stepper>(shadow);
   if (settings.birkhoffian_form == BirkhoffianForm::kPaper) {
-    return std::make_unique<AdaptiveCartStepperAdapter<Stepper, CartPaperBirkhoffian>>(stepper, settings, model,
-                                                                                      effects);
+    return std::make_unique<AdaptiveCartStepperAdapter<Stepper, CartPaperBirkhoffian>>(stepper, shadow_stepper, settings,
+                                                                                      model, effects);
   }
-  return std::make_unique<AdaptiveCartStepperAdapter<Stepper, CartAutonomousBirkhoffian>>(stepper, settings, model,
-                                                                                         effects);
+  return std::make_unique<AdaptiveCartStepperAdapter<Stepper, CartAutonomousBirkhoffian>>(stepper, shadow_stepper,
+                                                                                         settings, model, effects);
 }
 
 /// dopri5 under step_control adaptive: its run with the tolerance per step from the position
@@ -93,6 +96,10 @@ std::unique_ptr<CartStepper> adaptive_step(const IntegratorSettings& settings, c
 std::unique_ptr<CartStepper> adaptive_dopri5(const IntegratorSettings& settings, const CartModel& model,
                                              const EffectSet& effects) {
   require_position_tolerance(settings, to_string(StepControl::kAdaptive));
+  if (settings.global_error_estimate) {
+    throw std::invalid_argument("global_error_estimate is for the Birkhoffian members under step_control 'adaptive', "
+                                "not dopri5 (a shadow on doubled steps needs the member's own grid)");
+  }
   // A tenth of the position tolerance per second of the horizon: the default scene's 20 s amplify the
   // local errors most (half the tolerance per second ended 10.8× beyond it there); on drive_rr_drag,
   // sine_steer_torque and free_coast the error then lands between 1/200 and 1/5 of the tolerance.

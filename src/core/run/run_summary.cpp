@@ -2,6 +2,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+
+#include "birkhoff_cart/core/integrators/richardson_shadow.h"
 
 namespace birkhoff_cart {
 
@@ -23,7 +26,7 @@ std::string step_control_summary(const IntegratorSettings& settings, const StepS
     return text;
   }
   const char* control = to_string(settings.step_control);
-  char text[320];
+  char text[448];
   if (statistics.internal_steps == 0) {
     std::snprintf(text, sizeof text, "%s step control: position tolerance %.3g m (no internal step yet)", control,
                   settings.position_tolerance);
@@ -41,6 +44,20 @@ std::string step_control_summary(const IntegratorSettings& settings, const StepS
                   settings.position_tolerance, static_cast<unsigned long long>(statistics.internal_steps),
                   statistics.internal_step_min, statistics.internal_step_max,
                   static_cast<unsigned long long>(statistics.rejected_steps));
+    if (std::isfinite(statistics.global_error_estimate)) {
+      const std::size_t used = std::strlen(text);
+      std::snprintf(text + used, sizeof text - used,
+                    "; global error estimate %.2g m at t = %.6g s (Richardson shadow on %llu step pairs, %llu failed, "
+                    "largest h*rho(J) %.2g: %s)",
+                    statistics.global_error_estimate, statistics.global_error_estimate_time,
+                    static_cast<unsigned long long>(statistics.global_error_paired_steps),
+                    static_cast<unsigned long long>(statistics.global_error_failed_steps),
+                    statistics.global_error_stiffness,
+                    global_error_estimate_in_range(statistics.global_error_paired_steps,
+                                                   statistics.global_error_stiffness)
+                        ? "within its range"
+                        : "beyond its range, it may under-state the error");
+    }
   }
   return text;
 }

@@ -103,7 +103,7 @@ IntegratorSettings read_integrator(const SceneReader& reader, const YAML::Node& 
   reader.require_map(node, key,
                      {"name", "step_size", "tolerance", "birkhoffian_form", "max_newton_iterations",
                       "newton_tolerance", "compensated_summation", "local_error_estimate", "step_control",
-                      "position_tolerance", "tolerance_horizon"});
+                      "position_tolerance", "tolerance_horizon", "global_error_estimate"});
   IntegratorSettings settings;
   settings.name = reader.choice(node, key, "name", known_integrators());
   settings.step_size = reader.required_number(node, key, "step_size", Range::kPositive);
@@ -127,6 +127,11 @@ IntegratorSettings read_integrator(const SceneReader& reader, const YAML::Node& 
       reader.optional_number(node, key, "position_tolerance", Range::kPositive, settings.position_tolerance);
   settings.tolerance_horizon =
       reader.optional_number(node, key, "tolerance_horizon", Range::kPositive, settings.tolerance_horizon);
+  settings.global_error_estimate =
+      reader.optional_boolean(node, key, "global_error_estimate", settings.global_error_estimate);
+  if (settings.global_error_estimate && settings.step_control != StepControl::kAdaptive) {
+    reader.fail(key + ".global_error_estimate", "is only for 'step_control: adaptive'");
+  }
   // One meaning per key: `tolerance` is dopri5's local tolerance [-] (kept in the shipped scenes for a
   // switch to dopri5), `position_tolerance` the position error [m] a step control aims at.
   if (settings.step_control != StepControl::kFixed) {

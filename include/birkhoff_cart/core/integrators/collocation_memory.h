@@ -114,6 +114,14 @@ struct CollocationMemory {
     cached = 0;
     next_slot = 0;
   }
+  /// The stage points of `other` (times and rates), as starting values for a step that covers them
+  /// (a shadow step over two of other's steps: richardson_shadow.h); J and the inverses stay.
+  void take_stage_points(const CollocationMemory& other) {
+    count = other.count;
+    times = other.times;
+    for (int m = 0; m < other.count; ++m) rates[m] = other.rates[m];
+  }
+
   /// The stage history and J of `other`, without its cached inverses (a side step's copy: the
   /// inverses are h-specific and large).
   void copy_history_from(const CollocationMemory& other) {

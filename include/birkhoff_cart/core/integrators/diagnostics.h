@@ -20,6 +20,16 @@ struct StepStatistics {
   double internal_step_max = 0.0;                                            ///< largest |h| [s]
   std::uint64_t rejected_steps = 0;  ///< attempts the adaptive control rejected (adaptive_step_control.h); the reversible control's restarts with a smaller ε; at fixed steps, the steps whose whole step failed and that were taken in substeps of h/2, h/4, … (cart_stepper_adapter.h)
   double control_fictive_step = std::numeric_limits<double>::quiet_NaN();    ///< the reversible control's ε [rad]
+  /// Under the adaptive control with global_error_estimate (docs/accuracy.md §4.5): the position
+  /// error of B that the Richardson shadow estimates at the last time it met the grid [m] (NaN
+  /// before), that time [s], the shadow's steps over a pair of grid steps and its failed steps, and
+  /// the largest h·ρ(J) of its steps (ρ the Jacobian's spectral radius: above ~1 the estimate can
+  /// under-state, docs/accuracy.md §4.5).
+  double global_error_estimate = std::numeric_limits<double>::quiet_NaN();
+  double global_error_estimate_time = std::numeric_limits<double>::quiet_NaN();
+  std::uint64_t global_error_paired_steps = 0;
+  std::uint64_t global_error_failed_steps = 0;
+  double global_error_stiffness = 0.0;  ///< the largest h·ρ(J) of the shadow's steps [-]
 
   // The local error estimate (docs/accuracy.md): per step, the weighted max-norm
   //   ê = maxᵢ |x̂ᵢ − xᵢ| / max(1, |xᵢ(tₖ)|)
