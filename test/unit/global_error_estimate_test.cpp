@@ -159,7 +159,15 @@ TEST(GlobalErrorEstimate, TheCliReportsItAndRefusesItWithoutTheAdaptiveControl) 
       scene + " --step-control adaptive --position-tolerance 1e-7 --output-rate 10 --global-error-estimate", scratch);
   EXPECT_EQ(reported.exit_status, 0) << reported.standard_error;
   EXPECT_NE(reported.standard_output.find("global error estimate "), std::string::npos) << reported.standard_output;
-  EXPECT_NE(reported.standard_output.find("within its range"), std::string::npos) << reported.standard_output;
+  EXPECT_NE(reported.standard_output.find("within its range)"), std::string::npos) << reported.standard_output;
+  // gauss4 on the 60 s default scene at 1e-4 m ends 1.5e-4 m off (accuracy.md §4.5): the summary says so.
+  const birkhoff_cart_test::CliPrinted missed = birkhoff_cart_test::run_cart_simulate_printing(
+      "--scene '" + scene_path("default") + "' --integrator birkhoff_gauss4 --output '" + scratch +
+          "rows.csv' --quiet --step-control adaptive --position-tolerance 1e-4 --output-rate 10 --global-error-estimate",
+      scratch);
+  EXPECT_EQ(missed.exit_status, 0) << missed.standard_error;
+  EXPECT_NE(missed.standard_output.find("within its range, above the tolerance"), std::string::npos)
+      << missed.standard_output;
   const birkhoff_cart_test::CliPrinted fixed =
       birkhoff_cart_test::run_cart_simulate_printing(scene + " --step 0.01 --global-error-estimate", scratch);
   EXPECT_EQ(fixed.exit_status, 2);

@@ -26,7 +26,6 @@
 #include <cstdint>
 #include <limits>
 #include <Eigen/Eigenvalues>
-#include <optional>
 #include <sstream>
 #include <string>
 
@@ -120,7 +119,8 @@ class AdaptiveCartStepperAdapter final
     }
     if (met != Follow::kMet) return;
     const double t = control_.time();  // [s]
-    // h·ρ(J) of the shadow's step: beyond ~1 a mode is stepped over, outside (A.6)'s asymptotic range.
+    // h·ρ(J) of the shadow's step (J the grid's last Jacobian): beyond kLargestAsymptoticStiffness a
+    // mode is stepped over, outside (A.6)'s asymptotic range.
     const auto& memory = control_.grid().memory;
     if (memory.jacobian_valid) {
       const Eigen::EigenSolver<std::decay_t<decltype(memory.jacobian)>> modes(memory.jacobian, false);

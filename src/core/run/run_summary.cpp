@@ -53,10 +53,12 @@ std::string step_control_summary(const IntegratorSettings& settings, const StepS
                     static_cast<unsigned long long>(statistics.global_error_paired_steps),
                     static_cast<unsigned long long>(statistics.global_error_failed_steps),
                     statistics.global_error_stiffness,
-                    global_error_estimate_in_range(statistics.global_error_paired_steps,
-                                                   statistics.global_error_stiffness)
-                        ? "within its range"
-                        : "beyond its range, it may under-state the error");
+                    !global_error_estimate_in_range(statistics.global_error_paired_steps,
+                                                    statistics.global_error_stiffness)
+                        ? "beyond its range, it may under-state the error"
+                    : statistics.global_error_estimate > settings.position_tolerance
+                        ? "within its range, above the tolerance: ask a smaller one"
+                        : "within its range");
     }
   }
   return text;
