@@ -198,7 +198,7 @@ std::string usage() {
          " step control: the position error [m] allowed at the horizon\n"
          "  --global-error-estimate  " + adaptive + " step control, Gauss members: estimate the position error\n"
          "                          of B the run gathers (a shadow run on doubled steps; the summary reports\n"
-         "                          it); about half the work again, the same steps (docs/accuracy.md §4.5)\n"
+         "                          it); up to half the work again, the same steps (docs/accuracy.md §4.5)\n"
          "  --duration T            simulated time after the start [s], > 0\n"
          "  --output-rate HZ        output rows per simulated second [Hz], > 0\n"
          "  --birkhoffian-form F    " + alternatives(birkhoff_cart::birkhoffian_form_names(), ", ", " or ") + "\n"

@@ -139,6 +139,16 @@ TEST(GlobalErrorEstimate, RefusedWhereThereIsNoGridToFollow) {
   fixed.integrator.step_size = 0.01;
   EXPECT_THROW(Simulation simulation(fixed), std::invalid_argument);
   const std::string text = birkhoff_cart_test::read_file(scene_path("sine_steer_torque"));
+  try {  // the scene reader names dopri5 too (the Python module's load_scene reads scenes before any run)
+    load_scene_text(birkhoff_cart_test::replaced_once(
+                        text, "integrator:\n  name: birkhoff2 ",
+                        "integrator:\n  step_control: adaptive\n  position_tolerance: 1.0e-6\n"
+                        "  global_error_estimate: true\n  name: dopri5 "),
+                    "dopri5_estimate.yaml");
+    ADD_FAILURE() << "global_error_estimate with dopri5 was read";
+  } catch (const SceneError& error) {
+    EXPECT_NE(std::string(error.what()).find("dopri5"), std::string::npos) << error.what();
+  }
   for (const std::string control : {"fixed", "reversible"}) {
     const std::string integrator_block = "integrator:\n  step_control: " + control + "\n  global_error_estimate: true\n";
     std::string scene_text = birkhoff_cart_test::replaced_once(text, "integrator:\n", integrator_block);
@@ -168,6 +178,13 @@ TEST(GlobalErrorEstimate, TheCliReportsItAndRefusesItWithoutTheAdaptiveControl) 
   EXPECT_EQ(missed.exit_status, 0) << missed.standard_error;
   EXPECT_NE(missed.standard_output.find("within its range, above the tolerance"), std::string::npos)
       << missed.standard_output;
+  // In the paper form the CLI also probes the chart's momentum drift at fixed steps; the estimate is the run's.
+  const birkhoff_cart_test::CliPrinted paper = birkhoff_cart_test::run_cart_simulate_printing(
+      "--scene '" + scene_path("paper_special") + "' --integrator birkhoff_gauss6 --birkhoffian-form paper --output '" +
+          scratch + "rows.csv' --quiet --step-control adaptive --position-tolerance 1e-8 --global-error-estimate",
+      scratch);
+  EXPECT_EQ(paper.exit_status, 0) << paper.standard_error;
+  EXPECT_NE(paper.standard_output.find("global error estimate "), std::string::npos) << paper.standard_output;
   const birkhoff_cart_test::CliPrinted fixed =
       birkhoff_cart_test::run_cart_simulate_printing(scene + " --step 0.01 --global-error-estimate", scratch);
   EXPECT_EQ(fixed.exit_status, 2);

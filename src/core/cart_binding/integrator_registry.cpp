@@ -97,7 +97,7 @@ std::unique_ptr<CartStepper> adaptive_dopri5(const IntegratorSettings& settings,
                                              const EffectSet& effects) {
   require_position_tolerance(settings, to_string(StepControl::kAdaptive));
   if (settings.global_error_estimate) {
-    throw std::invalid_argument("global_error_estimate is for the Birkhoffian members under step_control 'adaptive', "
+    throw std::invalid_argument("global_error_estimate is for the Gauss members under step_control 'adaptive', "
                                 "not dopri5 (a shadow on doubled steps needs the member's own grid)");
   }
   // A tenth of the position tolerance per second of the horizon: the default scene's 20 s amplify the

@@ -23,6 +23,7 @@ double paper_form_momentum_change_per_step(const Scene& scene) {
   const EffectSet no_loads;
   IntegratorSettings settings = scene.integrator;
   settings.step_control = StepControl::kFixed;  // the chart's factor per step of h, whatever the run's control
+  settings.global_error_estimate = false;       // the adaptive control's; the probe steps at fixed h
   const std::unique_ptr<CartStepper> stepper = make_cart_stepper(settings, model, no_loads);
   CartState state;  // straight ahead at 1 m/s: p = M(0) ω is constant along the exact motion
   state.time = scene.initial_state.time;

@@ -132,6 +132,10 @@ IntegratorSettings read_integrator(const SceneReader& reader, const YAML::Node& 
   if (settings.global_error_estimate && settings.step_control != StepControl::kAdaptive) {
     reader.fail(key + ".global_error_estimate", "is only for 'step_control: adaptive'");
   }
+  if (settings.global_error_estimate && integrator_entry(settings.name).takes_tolerance()) {
+    reader.fail(key + ".global_error_estimate", "is for the Gauss members, not '" + settings.name +
+                                                    "' (a shadow on doubled steps needs the member's own grid)");
+  }
   // One meaning per key: `tolerance` is dopri5's local tolerance [-] (kept in the shipped scenes for a
   // switch to dopri5), `position_tolerance` the position error [m] a step control aims at.
   if (settings.step_control != StepControl::kFixed) {
