@@ -15,39 +15,27 @@ import concurrent.futures
 import math
 import os
 import re
-import subprocess
 import sys
-import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import tolerance_proportionality as proportionality  # noqa: E402  (the scenes, the reference runs)
 
 LOW, HIGH = 0.5, 10.0  # the band an estimate is counted in: [LOW, HIGH] x the error [-]
-LARGEST_STIFFNESS, FEWEST_PAIRS = 3.0, 8  # the estimate's range (richardson_shadow.h)
 
 
 def estimated_run(bin_dir, scene, member, tolerance, rate):
-    """(x, y) of the last row [m], the estimate [m], the rhs evaluations and the exit status."""
-    with tempfile.TemporaryDirectory() as tmp:
-        out = os.path.join(tmp, "out.csv")
-        argv = ["nice", "-n", "10", os.path.join(bin_dir, "cart_simulate"), "--scene",
-                os.path.join(proportionality.ROOT, "config", "scenes", scene + ".yaml"), "--integrator", member,
-                "--step-control", "adaptive", "--position-tolerance", repr(tolerance), "--output-rate", repr(rate),
-                "--global-error-estimate", "--output", out, "--quiet"]
-        process = subprocess.run(argv, capture_output=True, text=True)
-        row = {"scene": scene, "member": member, "tolerance": tolerance, "status": process.returncode}
-        found = re.search(r"global error estimate (\S+) m", process.stdout)
-        if process.returncode != 0 or not found:
-            row["reason"] = (process.stderr.strip().splitlines() or [""])[-1][:200]
-            return row
-        row["estimate"] = float(found.group(1))
-        found = re.search(r"on (\d+) step pairs, (\d+) failed, largest h\*rho\(J\) ([^:]+):", process.stdout)
-        row["paired"], row["failed"], row["stiffness"] = int(found.group(1)), int(found.group(2)), float(found.group(3))
-        with open(out) as f:
-            lines = [line for line in f.read().splitlines() if line.strip()]
-        values = dict(zip(lines[0].split(","), lines[-1].split(",")))
-        row["x"], row["y"] = float(values["x"]), float(values["y"])
+    """tolerance_proportionality's run under the adaptive control with the estimate: its row, with the
+    estimate [m], the shadow's pairs, failed steps and largest h·ρ(J), and the summary's verdict."""
+    row = proportionality.run(bin_dir, scene, member, "adaptive", tolerance, rate=rate,
+                              more=["--global-error-estimate"])
+    found = re.search(r"global error estimate (\S+) m .*on (\d+) step pairs, (\d+) failed, "
+                      r"largest h\*rho\(J\) ([^:]+): (within|beyond) its range", row.get("summary", ""))
+    if row["status"] != 0 or not found:
+        row["status"] = row["status"] or -1
         return row
+    row["estimate"], row["paired"], row["failed"] = float(found.group(1)), int(found.group(2)), int(found.group(3))
+    row["stiffness"], row["in_range"] = float(found.group(4)), found.group(5) == "within"
+    return row
 
 
 def main():
@@ -101,7 +89,7 @@ def main():
     for member in members:
         judged = [r for r in rows if r["member"] == member and r.get("resolved")]
         for in_range in (True, False):
-            mine = [r for r in judged if (r["paired"] >= FEWEST_PAIRS and r["stiffness"] <= LARGEST_STIFFNESS) == in_range]
+            mine = [r for r in judged if r["in_range"] == in_range]  # the summary's own verdict
             within = [r for r in mine if LOW * r["error"] <= r["estimate"] <= HIGH * r["error"]]
             ratios = sorted(r["estimate"] / r["error"] for r in mine)
             print("- %s, %s its range: %d of %d judged runs with the estimate within [%g, %g] x the error%s"

@@ -36,8 +36,9 @@ def duration_of(scene):
         return float(re.search(r"^duration:\s*([0-9.eE+-]+)", f.read(), re.M).group(1))
 
 
-def run(bin_dir, scene, member, control, tolerance=None, step=None, rate=None):
-    """One cart_simulate run: (x, y) of the last row [m], rhs evaluations, internal steps, rejected."""
+def run(bin_dir, scene, member, control, tolerance=None, step=None, rate=None, more=()):
+    """One cart_simulate run (`more`: further options): (x, y) of the last row [m], rhs evaluations,
+    internal steps, rejected, and the summary it printed."""
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "out.csv")
         argv = ["nice", "-n", "10", os.path.join(bin_dir, "cart_simulate"), "--scene",
@@ -47,7 +48,7 @@ def run(bin_dir, scene, member, control, tolerance=None, step=None, rate=None):
             argv += ["--position-tolerance", repr(tolerance)]
         if step is not None:
             argv += ["--step", repr(step)]
-        argv += ["--output-rate", repr(rate)]
+        argv += ["--output-rate", repr(rate), *more]
         process = subprocess.run(argv, capture_output=True, text=True)
         row = {"scene": scene, "member": member, "control": control, "tolerance": tolerance, "rate": rate,
                "status": process.returncode}
@@ -65,6 +66,7 @@ def run(bin_dir, scene, member, control, tolerance=None, step=None, rate=None):
         row["steps"] = int(found.group(1)) if found else None
         found = re.search(r"(\d+) (rejected|restarts)", process.stdout)
         row["rejected"] = int(found.group(1)) if found else None
+        row["summary"] = process.stdout
         return row
 
 

@@ -90,10 +90,15 @@ class AdaptiveCartStepperAdapter final
     if (global_error_estimate_) {
       // A new grid (the run's start, a command, a failed step, a new state): the shadow starts again
       // at its point; the error read so far is kept.
-      carried_error_ += met_error_;
-      met_error_.setZero();
+      keep_read_error();
       shadow_.start(control_.grid(), control_.time());
     }
+  }
+
+  /// Before the shadow restarts at the grid's point: the error it has read stays in the estimate.
+  void keep_read_error() {
+    carried_error_ += met_error_;
+    met_error_.setZero();
   }
 
   /// The shadow follows the grid's accepted step that ended at the grid's time (`closes`: on a point
@@ -113,10 +118,7 @@ class AdaptiveCartStepperAdapter final
     statistics.global_error_paired_steps = shadow_.paired_steps();
     statistics.global_error_failed_steps = shadow_.failed_steps();
     using Follow = typename RichardsonShadow<Stepper, System, Carried>::Follow;
-    if (met == Follow::kResynchronised) {
-      carried_error_ += met_error_;
-      met_error_.setZero();
-    }
+    if (met == Follow::kResynchronised) keep_read_error();
     if (met != Follow::kMet) return;
     const double t = control_.time();  // [s]
     // h·ρ(J) of the shadow's step (J the grid's last Jacobian): beyond kLargestAsymptoticStiffness a

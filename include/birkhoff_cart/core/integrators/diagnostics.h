@@ -23,7 +23,7 @@ struct StepStatistics {
   /// Under the adaptive control with global_error_estimate (docs/accuracy.md §4.5): the position
   /// error of B that the Richardson shadow estimates at the last time it met the grid [m] (NaN
   /// before), that time [s], the shadow's steps over a pair of grid steps and its failed steps, and
-  /// the largest h·ρ(J) of its steps (ρ the Jacobian's spectral radius: above ~1 the estimate can
+  /// the largest h·ρ(J) of its steps (ρ the Jacobian's spectral radius: above 3 the estimate can
   /// under-state, docs/accuracy.md §4.5).
   double global_error_estimate = std::numeric_limits<double>::quiet_NaN();
   double global_error_estimate_time = std::numeric_limits<double>::quiet_NaN();

@@ -50,8 +50,8 @@ struct IntegratorSettings {
   StepControl step_control = StepControl::kFixed;
   double position_tolerance = 0.0;  ///< reversible: the position error allowed at the horizon [m]; 0: not given
   double tolerance_horizon = 0.0;   ///< reversible: the time position_tolerance is for [s]; 0: the scene's duration
-  /// kAdaptive (Birkhoffian members): estimate the position error the run gathers by a Richardson
-  /// shadow run on doubled steps (docs/accuracy.md §4.5); about half the work again, same steps.
+  /// kAdaptive (the Gauss members): estimate the position error the run gathers by a Richardson
+  /// shadow run on doubled steps (docs/accuracy.md §4.5); up to half the work again, same steps.
   bool global_error_estimate = false;
 };
 

@@ -14,8 +14,8 @@
 // A pair never straddles a point the grid had to land on (a kink of the loads, where the member's
 // order is lost across it; a landing where a command may change): a step that ends there closes the
 // pair, alone if it is the pair's first (a lone step, the grid's own step map from the shadow's
-// state, adds no new information). A shadow step that fails (its stage solve, or a non-finite state)
-// restarts the shadow at the grid's point: the caller keeps the estimate it had (`resynchronised`).
+// state, adds no new information). A shadow step that fails (its stage solve, a non-finite state, or
+// the caller's plausibility check) restarts the shadow at the grid's point: the caller keeps the estimate it had (`resynchronised`).
 //
 // Its range (measured on the shipped scenes: docs/accuracy.md §4.5): the estimate follows the error
 // where every shadow step stays within its asymptotic range, h·ρ(J) ≤ 3 (ρ the spectral radius of
@@ -82,7 +82,7 @@ class RichardsonShadow {
       pending_ = true;
       return Follow::kPending;
     }
-    const bool pair = pending_;
+    const bool pair = pending_;  // else a lone step
     pending_ = false;
     const double h = t_end - time_;  // h₁ + h₂, or the lone step [s]
     bool solved = true;
@@ -106,7 +106,7 @@ class RichardsonShadow {
     last_step_ = h;
     time_ = t_end;
     if (after_kink) shadow_.memory.forget_stage_history();
-    ++(pair ? paired_steps_ : lone_steps_);
+    if (pair) ++paired_steps_;
     return Follow::kMet;
   }
 
@@ -114,7 +114,6 @@ class RichardsonShadow {
   double time() const { return time_; }  ///< [s]
   double last_step() const { return last_step_; }  ///< the shadow's last step [s]
   std::uint64_t paired_steps() const { return paired_steps_; }
-  std::uint64_t lone_steps() const { return lone_steps_; }
   std::uint64_t failed_steps() const { return failed_steps_; }
 
  private:
@@ -123,7 +122,6 @@ class RichardsonShadow {
   double last_step_ = 0.0;  ///< [s]
   bool pending_ = false;
   std::uint64_t paired_steps_ = 0;
-  std::uint64_t lone_steps_ = 0;
   std::uint64_t failed_steps_ = 0;
 };
 
