@@ -58,11 +58,12 @@ class AdaptiveCartStepperAdapter final
   static constexpr int kMaxSideStepHalvings = 6;
 
  public:
-  /// `shadow_stepper`: the member as the global error estimate's shadow steps it (without its ê).
-  AdaptiveCartStepperAdapter(const Stepper& stepper, const Stepper& shadow_stepper, const IntegratorSettings& settings,
+  /// `estimate_free_stepper`: the member without its ê, as the global error estimate's shadow and the
+  /// side steps to output instants step it.
+  AdaptiveCartStepperAdapter(const Stepper& stepper, const Stepper& estimate_free_stepper, const IntegratorSettings& settings,
                              const CartModel& model, const EffectSet& effects)
       : Base(model, effects, "adaptive"), effects_(&effects), control_(stepper, control_settings(settings)),
-        shadow_stepper_(shadow_stepper), position_tolerance_(settings.position_tolerance),
+        estimate_free_stepper_(estimate_free_stepper), position_tolerance_(settings.position_tolerance),
         global_error_estimate_(settings.global_error_estimate),
         stage_change_per_unit_step_(control_.settings().stage_change_fraction * control_.settings().error_per_unit_step) {}
 
@@ -87,6 +88,7 @@ class AdaptiveCartStepperAdapter final
     control_.start(seed, state.time, first_step(seed, state.time, statistics));
     dense_.clear();
     dense_.push(control_.grid(), control_.time());
+    side_steps_from_ = std::numeric_limits<double>::quiet_NaN();  // a new grid: no side step's J carries over
     if (global_error_estimate_) {
       // A new grid (the run's start, a command, a failed step, a new state): the shadow starts again
       // at its point; the error read so far is kept.
@@ -107,7 +109,7 @@ class AdaptiveCartStepperAdapter final
   void follow_with_shadow(bool closes, bool after_kink, StepStatistics& statistics) {
     StepStatistics shadow_work;  // its work counts in the run's; its ê (none) is not the run's
     const auto met = shadow_.follow(
-        system_, shadow_stepper_, control_.grid(), control_.time(), closes, after_kink, stage_change_per_unit_step_,
+        system_, estimate_free_stepper_, control_.grid(), control_.time(), closes, after_kink, stage_change_per_unit_step_,
         [this](const auto& before, const auto& after, double t, double h) {
           return stepper_checks::energy_balance_holds(system_.model(), cart_state(before, t), cart_state(after, t + h));
         },
@@ -196,9 +198,12 @@ class AdaptiveCartStepperAdapter final
   }
 
   /// The state at `target` by one step of the member from the grid point before it: exact to the
-  /// member's order where the dense output's estimate says it is not. A side step whose stage solve
-  /// fails or lands on a spurious root (non-finite, or the energy balance broken) is retried in 2,
-  /// 4, … 2^kMaxSideStepHalvings substeps, as the control retries a rejected attempt smaller.
+  /// member's order where the dense output's estimate says it is not. The step lies inside the grid's
+  /// last step, so its stage solve starts from that step's stage points (interpolated, not an explicit
+  /// start) and its J, and stops at the accuracy the tolerance needs (κ·τ·h, eq. (B.49)), as a grid
+  /// step does; it reads no ê (the run's ê is its grid's). A side step whose stage solve fails or
+  /// lands on a spurious root (non-finite, or the energy balance broken) is retried in 2, 4, …
+  /// 2^kMaxSideStepHalvings substeps, as the control retries a rejected attempt smaller.
   void side_step(double target, StepStatistics& statistics) {
     const double start = control_.previous_time();  // [s]
     std::string last;
@@ -206,14 +211,15 @@ class AdaptiveCartStepperAdapter final
       const int pieces = 1 << halvings;
       output_.point = control_.previous();
       output_.turns = control_.previous_turns();
-      Memory memory;  // no stage history: an explicit start
+      side_memory_.start_side_step_from(control_.grid().memory, stage_change_per_unit_step_ * (target - start) / pieces,
+                                        side_steps_from_ == start);
       try {
         for (int k = 1; k <= pieces; ++k) {
           const double from = start + (target - start) * static_cast<double>(k - 1) / pieces;           // [s]
           const double to = k == pieces ? target : start + (target - start) * static_cast<double>(k) / pieces;  // [s]
           const CompensatedPoint<System> before = output_.point;
           system_traits::begin_step(system_, from);
-          control_.stepper().advance_compensated(system_, output_.point, memory, from, to - from, statistics);
+          estimate_free_stepper_.advance_compensated(system_, output_.point, side_memory_, from, to - from, statistics);
           const bool finite = output_.point.z.allFinite() && output_.point.y.allFinite();
           if (!finite || !stepper_checks::energy_balance_holds(system_.model(), cart_state(before, from),
                                                                cart_state(output_.point, to))) {
@@ -221,6 +227,7 @@ class AdaptiveCartStepperAdapter final
           }
         }
         output_.reduce_angles();
+        side_steps_from_ = start;
         return;
       } catch (const StepError& error) {
         last = error.what();
@@ -240,7 +247,9 @@ class AdaptiveCartStepperAdapter final
 
   const EffectSet* effects_;
   Control control_;
-  Stepper shadow_stepper_;  ///< the member without its ê, for the shadow
+  Stepper estimate_free_stepper_;  ///< the member without its ê: the shadow's steps and the side steps
+  Memory side_memory_;             ///< a side step's (kept: it is large, and set afresh for each)
+  double side_steps_from_ = std::numeric_limits<double>::quiet_NaN();  ///< the grid time its J belongs to [s]
   double position_tolerance_;  ///< [m]
   bool global_error_estimate_;
   double stage_change_per_unit_step_;  ///< κ·τ: the stage solve stops at this·h [1/s] (B.49)
