@@ -20,6 +20,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -129,10 +130,11 @@ class ReversibleCartStepperAdapter final
     control_.start(seed, state.time);
     dense_.clear();
     push_dense();
+    side_steps_from_ = std::numeric_limits<double>::quiet_NaN();  // a new grid: no side step's J carries over
   }
 
   /// The carried point at `target` in output_: grid steps until the grid reaches or passes it,
-  /// then the grid point itself, a side step (landings) or the dense output.
+  /// then the grid point itself, a landing step, the dense output or a side step.
   void advance(double target, StepStatistics& statistics) {
     control_.advance_past(target, statistics, [&] {
       push_dense();
@@ -143,19 +145,44 @@ class ReversibleCartStepperAdapter final
     const bool land = instants_.exact_at(target);
     if (control_.time() == target) {
       output_.take_point(control_.grid());
-    } else if (land || !(dense_.at(system_, target, output_, statistics) <= settings_.position_tolerance)) {
-      side_step(target, statistics);  // exact, or where the dense output's own estimate exceeds the tolerance
+    } else if (land) {
+      landing_step(target, statistics);
+    } else if (!(dense_.at(system_, target, output_, statistics) <= settings_.position_tolerance)) {
+      side_step(target, statistics);  // where the dense output's own estimate exceeds the tolerance
     }
   }
 
-  /// The state at `target` by one step of the untransformed member from the grid point before it.
+  /// The state at a landing instant `target` (the run's end, a land_on() instant, a command's) by one
+  /// step of the untransformed member from the grid point before it, from an explicit start and
+  /// converged to round-off: a new grid may start from it.
+  void landing_step(double target, StepStatistics& statistics) {
+    output_.take_point(control_.previous());
+    CompensatedPoint<System> point = output_.point;
+    SideMemory memory;
+    const double start = control_.previous_time();  // [s]
+    control_.stepper().advance_compensated(system_, point, memory, start, target - start, statistics);
+    output_.point = point;
+    output_.reduce_angles();
+  }
+
+  /// The state at an output instant `target` by one step of the untransformed member from the grid
+  /// point before it, from an explicit start (the grid's stage points are in the fictive time). Its
+  /// stage solve stops at the accuracy the tolerance needs (κ·τ·h, eq. (B.49)), and it keeps the J
+  /// an earlier side step from the same grid point computed.
   void side_step(double target, StepStatistics& statistics) {
     const auto& previous = control_.previous();
     output_.take_point(previous);
     CompensatedPoint<System> point = output_.point;
-    SideMemory memory;  // no stage history: an explicit start
-    const double start = control_.previous_time();
-    control_.stepper().advance_compensated(system_, point, memory, start, target - start, statistics);
+    const double start = control_.previous_time();  // [s]
+    const bool keep_jacobian = side_steps_from_ == start && side_memory_.jacobian_valid;
+    side_memory_.count = 0;  // no stage history: an explicit start
+    side_memory_.forget_end_rate();
+    side_memory_.cached = 0;
+    side_memory_.next_slot = 0;
+    if (!keep_jacobian) side_memory_.jacobian_valid = false;
+    side_memory_.stage_change_limit = kStageChangeFraction * error_per_unit_step() * (target - start);
+    control_.stepper().advance_compensated(system_, point, side_memory_, start, target - start, statistics);
+    side_steps_from_ = start;
     output_.point = point;
     output_.reduce_angles();
   }
@@ -171,9 +198,14 @@ class ReversibleCartStepperAdapter final
     }
   }
 
+  /// κ of the side step's stop (eq. (B.49), as the adaptive control's) [-].
+  static constexpr double kStageChangeFraction = 0.01;
+
   Transformed transformed_;
   IntegratorSettings settings_;
   Control control_;
+  SideMemory side_memory_;  ///< a side step's (kept: it is large)
+  double side_steps_from_ = std::numeric_limits<double>::quiet_NaN();  ///< the grid time its J belongs to [s]
 };
 
 }  // namespace birkhoff_cart
