@@ -258,6 +258,15 @@ MUTATIONS = [
         [("global_error_estimate_test", "*")],
     ),
     Mutation(
+        "side_step_solves_to_round_off",
+        "a side step to an output row converges its stage solve to round-off instead of the accuracy the "
+        "tolerance needs: the same rows, several more iterations each",
+        "src/core/cart_binding/adaptive_cart_stepper.h",
+        "side_memory_.start_side_step_from(control_.grid().memory, stage_change_per_unit_step_ * (target - start) / pieces,",
+        "side_memory_.start_side_step_from(control_.grid().memory, 0.0 * (target - start) / pieces,",
+        [("adaptive_step_control_test", "SideSteps.*")],
+    ),
+    Mutation(
         "cli_ignores_output_rate",
         "cart_simulate accepts --output-rate but ignores it: the documented whirl command (h = 0.02 s, "
         "--output-rate 10) is refused for the scene's 100 Hz output",

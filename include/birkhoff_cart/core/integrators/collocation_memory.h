@@ -50,11 +50,6 @@ struct CollocationMemory {
   /// control's tolerance needs (gauss_stage_solver.h). 0: converge to round-off.
   double stage_change_limit = 0.0;
 
-  /// The next step lies inside the step whose stage points are held (a side step from that step's
-  /// start to an instant within it): its starting values interpolate those points whatever its h
-  /// (gauss_collocation.h). Cleared when the step's own stage points replace them.
-  bool inside_remembered_step = false;
-
   /// The part of the memory a rejected step must give back (stage history and end rate; J and the
   /// Newton inverses stay: they are keyed by h and remain a good approximation).
   struct History {
@@ -85,13 +80,11 @@ struct CollocationMemory {
   /// After a kink of the loads: the stage derivatives of the steps before no longer extrapolate.
   void forget_stage_history() {
     count = 0;
-    inside_remembered_step = false;
     forget_end_rate();
   }
 
   void clear() {
     count = 0;
-    inside_remembered_step = false;
     forget_jacobian();
     forget_end_rate();
   }
@@ -130,9 +123,9 @@ struct CollocationMemory {
   }
 
   /// A side step's memory from the grid's (`grid`, after its last accepted step): that step's stage
-  /// points, to interpolate from (inside_remembered_step), and J, without cached inverses or end
-  /// rates; the solve stops at `limit` (stage_change_limit). With `keep_own_jacobian` (an earlier side
-  /// step inside the same grid step left one) this memory's J stands in where the grid has none.
+  /// points, for starting values (eq. (B.32)), and J, without cached inverses or end rates; the solve
+  /// stops at `limit` (stage_change_limit). With `keep_own_jacobian` (an earlier side step inside the
+  /// same grid step left one) this memory's J stands in where the grid has none.
   void start_side_step_from(const CollocationMemory& grid, double limit, bool keep_own_jacobian) {
     const bool keep = keep_own_jacobian && jacobian_valid && !grid.jacobian_valid;
     const Eigen::Matrix<double, kDimension, kDimension> own = jacobian;
@@ -143,7 +136,6 @@ struct CollocationMemory {
     }
     forget_end_rate();
     stage_change_limit = limit;
-    inside_remembered_step = true;
   }
 
   /// The stage history and J of `other`, without its cached inverses (a side step's copy: the

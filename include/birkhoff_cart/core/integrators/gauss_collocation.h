@@ -237,25 +237,9 @@ class GaussCollocation {
   }
 
   /// Extrapolating over many steps' length, or through coincident times, is worse than one explicit
-  /// evaluation. A step inside the remembered one (CollocationMemory::inside_remembered_step: a side
-  /// step to an output instant) interpolates its collocation polynomial whatever its own h: sound
-  /// while its stage times lie within the remembered stage times' spread of them.
+  /// evaluation.
   template <class System>
   static bool extrapolation_is_sound(const CollocationMemory<System, Stages>& memory, double t, double h) {
-    if (memory.inside_remembered_step && memory.count >= 2) {
-      double earliest = memory.times[0];  // [s]
-      double latest = memory.times[0];    // [s]
-      for (int m = 1; m < memory.count; ++m) {
-        earliest = std::min(earliest, memory.times[m]);
-        latest = std::max(latest, memory.times[m]);
-      }
-      const double spread = latest - earliest;  // [s]
-      const double first = t + gauss_legendre_tableau(Stages).nodes[0] * h;
-      const double last = t + gauss_legendre_tableau(Stages).nodes[Stages - 1] * h;
-      if (spread > 0.0 && std::min(first, last) >= earliest - spread && std::max(first, last) <= latest + spread) {
-        return true;
-      }
-    }
     for (int j = 0; j < memory.count; ++j) {
       if (!(std::abs(memory.times[j] - t) <= 50.0 * std::abs(h))) return false;
       for (int m = 0; m < j; ++m) {
@@ -270,7 +254,6 @@ class GaussCollocation {
   template <class System, class S>
   static void remember(CollocationMemory<System, Stages>& memory, const std::array<double, Stages>& stage_times,
                        const std::array<StateVector<System, S>, Stages>& stage_rates) {
-    memory.inside_remembered_step = false;
     if constexpr (Stages == 1) {
       constexpr int kPoints = 3;
       for (int j = std::min(memory.count, kPoints - 1); j > 0; --j) {
