@@ -52,6 +52,7 @@
 #include <string>
 #include <vector>
 
+#include "birkhoff_cart/core/support/csv_number.h"
 #include "birkhoff_cart/core/scene/accuracy_guard.h"
 #include "birkhoff_cart/core/support/closest_name.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
@@ -375,31 +376,48 @@ std::string key_with_option(const std::string& key) {
   return key;
 }
 
-/// One CSV row at `time` [s].
+/// One CSV row at `time` [s], its numbers as %.17g writes them (csv_number.h).
 void write_row(std::FILE* file, double time, const Simulation& simulation, birkhoff_cart::OdometrySensor* sensor) {
   const CartState& state = simulation.state();
   const birkhoff_cart::CartModel& model = simulation.model();
-  std::fprintf(file, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,", time,
-               state.x, state.y, state.heading, state.steering_angle, state.wheel_spin_angle[0],
-               state.wheel_spin_angle[1], state.wheel_spin_angle[2], state.wheel_spin_angle[3], state.arc_length,
-               state.forward_speed, state.steering_rate, model.energy(state), model.steering_momentum(state));
+  std::string row;
+  row.reserve(512);
+  const auto add = [&row](double value) {
+    birkhoff_cart::append_csv_number(row, value);
+    row += ',';
+  };
+  for (double value : {time, state.x, state.y, state.heading, state.steering_angle, state.wheel_spin_angle[0],
+                       state.wheel_spin_angle[1], state.wheel_spin_angle[2], state.wheel_spin_angle[3], state.arc_length,
+                       state.forward_speed, state.steering_rate, model.energy(state), model.steering_momentum(state)}) {
+    add(value);
+  }
   const birkhoff_cart::StepStatistics& statistics = simulation.statistics();
   const double estimate = statistics.local_error_estimate_last_step;  // ê [-]; none before the first step
   if (birkhoff_cart::has_local_error_estimate(statistics) && std::isfinite(estimate)) {
-    std::fprintf(file, "%.17g", estimate);
+    birkhoff_cart::append_csv_number(row, estimate);
   }
   if (sensor) {  // the odometry sensor's estimate of A and its standard deviations (docs/odometry_sensor.md)
     const birkhoff_cart::OdometryEstimate& odometry = sensor->read(state);
-    std::fprintf(file, ",%.17g,%.17g,%.17g,%.17g,%.17g", odometry.x, odometry.y, odometry.heading,
-                 std::sqrt(odometry.pose_covariance(0, 0) + odometry.pose_covariance(1, 1)),
-                 std::sqrt(odometry.pose_covariance(2, 2)));
+    for (double value : {odometry.x, odometry.y, odometry.heading,
+                         std::sqrt(odometry.pose_covariance(0, 0) + odometry.pose_covariance(1, 1)),
+                         std::sqrt(odometry.pose_covariance(2, 2))}) {
+      row += ',';
+      birkhoff_cart::append_csv_number(row, value);
+    }
   }
   // The actuators' applied torques and the end-stop contact (docs/actuators.md), when enabled.
   const Simulation::ActuatorStatus actuators = simulation.actuator_status();
-  if (actuators.steering_actuator) std::fprintf(file, ",%.17g", actuators.steering_applied);
-  if (actuators.drive_actuator) std::fprintf(file, ",%.17g", actuators.drive_applied);
-  if (actuators.end_stops) std::fprintf(file, ",%d", actuators.end_stop_contact);
-  std::fprintf(file, "\n");
+  if (actuators.steering_actuator) {
+    row += ',';
+    birkhoff_cart::append_csv_number(row, actuators.steering_applied);
+  }
+  if (actuators.drive_actuator) {
+    row += ',';
+    birkhoff_cart::append_csv_number(row, actuators.drive_applied);
+  }
+  if (actuators.end_stops) row += "," + std::to_string(actuators.end_stop_contact);
+  row += '\n';
+  std::fwrite(row.data(), 1, row.size(), file);
 }
 
 /// At most one line per kProgressPeriod of wall time: percent of scene time, real-time factor.
