@@ -152,37 +152,33 @@ class ReversibleCartStepperAdapter final
     }
   }
 
-  /// The state at a landing instant `target` (the run's end, a land_on() instant, a command's) by one
-  /// step of the untransformed member from the grid point before it, from an explicit start and
-  /// converged to round-off: a new grid may start from it.
+  /// The state at a landing instant `target` (the run's end, a land_on() instant, a command's): a
+  /// step from the grid point before it with a fresh memory, converged to round-off: a new grid may
+  /// start from it.
   void landing_step(double target, StepStatistics& statistics) {
-    output_.take_point(control_.previous());
-    CompensatedPoint<System> point = output_.point;
     SideMemory memory;
-    const double start = control_.previous_time();  // [s]
-    control_.stepper().advance_compensated(system_, point, memory, start, target - start, statistics);
-    output_.point = point;
-    output_.reduce_angles();
+    step_from_previous(target, memory, statistics);
   }
 
-  /// The state at an output instant `target` by one step of the untransformed member from the grid
-  /// point before it, from an explicit start (the grid's stage points are in the fictive time). Its
-  /// stage solve stops at the accuracy the tolerance needs (κ·τ·h, eq. (B.49)), and it keeps the J
-  /// an earlier side step from the same grid point computed.
+  /// The state at an output instant `target`: a step from the grid point before it, from an explicit
+  /// start (the grid's stage points are in the fictive time), stopping at the accuracy the tolerance
+  /// needs (κ·τ·h, eq. (B.49)) and keeping the J an earlier side step from the same grid point
+  /// computed.
   void side_step(double target, StepStatistics& statistics) {
-    const auto& previous = control_.previous();
-    output_.take_point(previous);
+    const double start = control_.previous_time();  // [s]
+    side_memory_.forget_stage_history();
+    if (side_steps_from_ != start) side_memory_.forget_jacobian();
+    side_memory_.stage_change_limit = kStageChangeFraction * error_per_unit_step() * (target - start);
+    step_from_previous(target, side_memory_, statistics);
+    side_steps_from_ = start;
+  }
+
+  /// output_ at `target` by one step of the untransformed member from the grid point before it.
+  void step_from_previous(double target, SideMemory& memory, StepStatistics& statistics) {
+    output_.take_point(control_.previous());
     CompensatedPoint<System> point = output_.point;
     const double start = control_.previous_time();  // [s]
-    const bool keep_jacobian = side_steps_from_ == start && side_memory_.jacobian_valid;
-    side_memory_.count = 0;  // no stage history: an explicit start
-    side_memory_.forget_end_rate();
-    side_memory_.cached = 0;
-    side_memory_.next_slot = 0;
-    if (!keep_jacobian) side_memory_.jacobian_valid = false;
-    side_memory_.stage_change_limit = kStageChangeFraction * error_per_unit_step() * (target - start);
-    control_.stepper().advance_compensated(system_, point, side_memory_, start, target - start, statistics);
-    side_steps_from_ = start;
+    control_.stepper().advance_compensated(system_, point, memory, start, target - start, statistics);
     output_.point = point;
     output_.reduce_angles();
   }
