@@ -108,17 +108,31 @@ TEST_P(NewestStepState, IsTheGridPointAtTheStepsEndAndTheRunsOwnOutputInside) {
   EXPECT_EQ(simulation.state().y, untouched.state().y);
   EXPECT_EQ(simulation.state().heading, untouched.state().heading);
   // Its counters too: what the readings evaluate (the rates of held points the Hermite interpolant
-  // lacks; here every grid point brings its own) is counted apart.
+  // lacks, none here: every grid point brings its own; the side steps where the interpolant's
+  // estimate exceeds the tolerance) is counted apart.
   EXPECT_EQ(simulation.statistics().rhs_evaluations, untouched.statistics().rhs_evaluations);
-  EXPECT_EQ(reading.rhs_evaluations, 0u);
-  // Inside a step: what the run hands out at that instant (its dense output), to the last digits.
+  // Inside a step: what the run hands out at that instant (its dense output or its side step), bit
+  // for bit under the step control (a row depends on the grid and its instant only, whatever was
+  // read or output before in the step), to the last digits for dopri5.
   double worst = 0.0;  // [m]
   for (std::size_t k = 0; k < middles.size(); ++k) {
     if (middles[k] <= outputs.state().time) continue;
     outputs.advance_output_to(middles[k]);
     worst = std::max(worst, std::hypot(outputs.state().x - read[k].x, outputs.state().y - read[k].y));
+    if (GetParam() != "dopri5") {
+      EXPECT_EQ(outputs.state().x, read[k].x) << middles[k];
+      EXPECT_EQ(outputs.state().forward_speed, read[k].forward_speed) << middles[k];
+      EXPECT_EQ(outputs.state().steering_rate, read[k].steering_rate) << middles[k];
+    }
   }
   EXPECT_LE(worst, 1e-12) << GetParam();
+  // Some readings here are side steps (at 1e-9 m), so the bit-for-bit check covers them; dopri5's
+  // readings evaluate nothing.
+  if (GetParam() == "dopri5") {
+    EXPECT_EQ(reading.rhs_evaluations, 0u);
+  } else {
+    EXPECT_GT(reading.rhs_evaluations, 0u);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(OwnSteps, NewestStepState, ::testing::Values("birkhoff_gauss6", "dopri5"));

@@ -48,6 +48,7 @@ class AdaptiveCartStepperAdapter final
   using Memory = typename Stepper::template Memory<System>;
   using Carried = CarriedCartState<System, Memory>;
   using Control = AdaptiveStepControl<Stepper, System, Carried>;
+  using Output = typename Base::Output;
   using Base::dense_;
   using Base::instants_;
   using Base::output_;
@@ -88,7 +89,7 @@ class AdaptiveCartStepperAdapter final
     control_.start(seed, state.time, first_step(seed, state.time, statistics));
     dense_.clear();
     dense_.push(control_.grid(), control_.time());
-    side_steps_from_ = std::numeric_limits<double>::quiet_NaN();  // a new grid: no side step's J carries over
+    side_jacobian_at_ = std::numeric_limits<double>::quiet_NaN();  // a new grid: no side step's J carries over
     if (global_error_estimate_) {
       // A new grid (the run's start, a command, a failed step, a new state): the shadow starts again
       // at its point; the error read so far is kept.
@@ -192,42 +193,60 @@ class AdaptiveCartStepperAdapter final
     if (control_.time() == target) {
       output_.point = grid.point;
       output_.turns = grid.turns;
-    } else if (!(dense_.at(system_, target, output_, statistics) <= position_tolerance_)) {
-      side_step(target, statistics);  // where the dense output's own estimate exceeds the tolerance
+    } else {
+      between_grid_points(target, output_, statistics);
     }
+  }
+
+  /// The carried point at `target` inside the grid's newest step in `out`: the dense output, or a
+  /// side step where the dense output's own estimate exceeds the tolerance. Depends on the grid and
+  /// `target` only (the rows asked before do not change it), so a read by newest_step_state is the
+  /// row the run would output there.
+  void between_grid_points(double target, Output& out, StepStatistics& statistics) {
+    if (!(dense_.at(system_, target, out, statistics) <= position_tolerance_)) side_step(target, out, statistics);
   }
 
   /// The state at `target` by one step of the member from the grid point before it: exact to the
   /// member's order where the dense output's estimate says it is not. The step lies inside the grid's
   /// last step, so its stage solve starts from that step's stage points (interpolated, not an explicit
-  /// start) and its J, and stops at the accuracy the tolerance needs (κ·τ·h, eq. (B.49)), as a grid
-  /// step does; it reads no ê (the run's ê is its grid's). A side step whose stage solve fails or
+  /// start) and its J — where the grid has none, J at the grid point before, computed by the first
+  /// side step in the grid step and kept for the others — and stops at the accuracy the tolerance
+  /// needs (κ·τ·h, eq. (B.49)), as a grid step does; it reads no ê (the run's ê is its grid's). A side
+  /// step whose stage solve fails or
   /// lands on a spurious root (non-finite, or the energy balance broken) is retried in 2, 4, …
   /// 2^kMaxSideStepHalvings substeps, as the control retries a rejected attempt smaller.
-  void side_step(double target, StepStatistics& statistics) {
+  void side_step(double target, Output& out, StepStatistics& statistics) {
     const double start = control_.previous_time();  // [s]
+    const auto& grid_memory = control_.grid().memory;
+    if (!grid_memory.jacobian_valid && side_jacobian_at_ != start) {
+      const CompensatedPoint<System>& before = control_.previous();
+      const StateVector<System, double> z = before.z + before.z_remainder;
+      side_jacobian_ = system_traits::darboux_jacobian(system_, system_.to_darboux(z, start), start);
+      ++statistics.rhs_evaluations;  // one evaluation of J, as the stage solve counts it
+      if (!side_jacobian_.allFinite()) throw StepError("the side step met a non-finite Jacobian");
+      side_jacobian_at_ = start;
+    }
     std::string last;
     for (int halvings = 0; halvings <= kMaxSideStepHalvings; ++halvings) {
       const int pieces = 1 << halvings;
-      output_.point = control_.previous();
-      output_.turns = control_.previous_turns();
-      side_memory_.start_side_step_from(control_.grid().memory, stage_change_per_unit_step_ * (target - start) / pieces,
-                                        side_steps_from_ == start);
+      out.point = control_.previous();
+      out.turns = control_.previous_turns();
+      side_memory_.start_side_step_from(grid_memory, stage_change_per_unit_step_ * (target - start) / pieces,
+                                        grid_memory.jacobian_valid ? nullptr : &side_jacobian_);
       try {
         for (int k = 1; k <= pieces; ++k) {
           const double from = start + (target - start) * static_cast<double>(k - 1) / pieces;           // [s]
           const double to = k == pieces ? target : start + (target - start) * static_cast<double>(k) / pieces;  // [s]
-          const CompensatedPoint<System> before = output_.point;
+          const CompensatedPoint<System> before = out.point;
           system_traits::begin_step(system_, from);
-          estimate_free_stepper_.advance_compensated(system_, output_.point, side_memory_, from, to - from, statistics);
-          const bool finite = output_.point.z.allFinite() && output_.point.y.allFinite();
+          estimate_free_stepper_.advance_compensated(system_, out.point, side_memory_, from, to - from, statistics);
+          const bool finite = out.point.z.allFinite() && out.point.y.allFinite();
           if (!finite || !stepper_checks::energy_balance_holds(system_.model(), cart_state(before, from),
-                                                               cart_state(output_.point, to))) {
+                                                               cart_state(out.point, to))) {
             throw StepError("a non-finite state or a broken energy balance (a spurious root)");
           }
         }
-        output_.reduce_angles();
-        side_steps_from_ = start;
+        out.reduce_angles();
         return;
       } catch (const StepError& error) {
         last = error.what();
@@ -249,7 +268,9 @@ class AdaptiveCartStepperAdapter final
   Control control_;
   Stepper estimate_free_stepper_;  ///< the member without its ê: the shadow's steps and the side steps
   Memory side_memory_;             ///< a side step's (kept: it is large, and set afresh for each)
-  double side_steps_from_ = std::numeric_limits<double>::quiet_NaN();  ///< the grid time its J belongs to [s]
+  /// The side steps' J where the grid has none: at the grid point before, of time side_jacobian_at_ [s].
+  Eigen::Matrix<double, System::kDimension, System::kDimension> side_jacobian_;
+  double side_jacobian_at_ = std::numeric_limits<double>::quiet_NaN();
   double position_tolerance_;  ///< [m]
   bool global_error_estimate_;
   double stage_change_per_unit_step_;  ///< κ·τ: the stage solve stops at this·h [1/s] (B.49)

@@ -30,14 +30,19 @@ class ControlledCartStepper : public CartStepper {
   int order() const override { return Stepper::kOrder; }
   void land_on(double time) override { instants_.land_on(time); }
   void observe_grid(GridObserver observer) override { observer_ = std::move(observer); }
-  /// The grid's Hermite interpolant (grid_dense_output.h) on its newest step, on a copy of the
-  /// handed-out point: the run and its output stay as they were (the held points' rates it may
-  /// evaluate, counted in `work`, are the ones the next output would, which then takes them as known).
+  /// The state the run would output at `time` inside the grid's newest step — the grid's Hermite
+  /// interpolant (grid_dense_output.h), or a side step where its estimate exceeds the tolerance —
+  /// on a copy of the handed-out point: the run and its output stay as they were (the work, counted
+  /// in `work`: the held points' rates, which the next output then takes as known, and the side step).
   bool newest_step_state(double time, CartState& out, StepStatistics& work) override {
     if (dense_.size() < 2 || !(time >= dense_.time(1) && time <= dense_.time(0))) return false;
     Output probe = output_;
     probe.periodic_angles = system_traits::periodic_angles(system_);
-    dense_.at(system_, time, probe, work);
+    try {
+      derived().between_grid_points(time, probe, work);
+    } catch (const StepError& error) {
+      throw StepError(name_ + " (" + control_name_ + " step control): " + error.what());
+    }
     out = probe.output(system_, time);
     return true;
   }

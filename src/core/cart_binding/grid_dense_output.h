@@ -1,8 +1,9 @@
 // The dense output of a step control's grid for the cart (docs/birkhoffian.md §12.3): the grid
 // points in (z, y) with the system's angles (χ and θ) kept on one branch — the whole turns the grid
 // took out of a point are put back relative to the newest point — and their Hermite interpolant
-// (hermite_dense_output.h), whose error is estimated on the position (x, y). Private to the core
-// library.
+// (hermite_dense_output.h), whose error is estimated on the state: the position (x, y) in metres,
+// the Birkhoffian z (with the momenta), the heading and the wheel angles in ê's weights
+// (error_estimate.h), as the grid's own steps are judged. Private to the core library.
 #pragma once
 
 #include <Eigen/Core>
@@ -72,8 +73,12 @@ class GridDenseOutput {
 
   /// The carried point at t [s] (inside the newest step) in `out`, with the newest point's turns.
   /// The rates of the points that lack them are evaluated here, once each. Returns an estimate of
-  /// the interpolant's position error [m] (against the interpolant one point shorter: a conservative
-  /// one; NaN with a single point).
+  /// the interpolant's error (against the interpolant one point shorter: a conservative one; NaN
+  /// with a single point): the larger of the position's [m] and every other state component's in
+  /// ê's weights [-], both read against a position tolerance's number. The position alone would pass
+  /// rows whose speeds are far off where the held points crowd at one end of a long newest step (a
+  /// start's first steps grow 100× each: the interpolant is then a Taylor polynomial far from its
+  /// centre, and the position is still near zero).
   template <class Carried>
   double at(System& system, double t, Carried& out, StepStatistics& statistics) {
     for (int j = 0; j < history_.size(); ++j) {
@@ -95,11 +100,22 @@ class GridDenseOutput {
     out.point.z_remainder.setZero();
     out.point.y_remainder.setZero();
     out.turns = turns_;
-    return std::hypot(difference(System::kDimension + kXIndex), difference(System::kDimension + kYIndex));
+    constexpr int kX = System::kDimension + kXIndex;
+    constexpr int kY = System::kDimension + kYIndex;
+    double estimate = std::hypot(difference(kX), difference(kY));  // [m]
+    for (int i = 0; i < kConfigurationEnd; ++i) {
+      if (i == kX || i == kY) continue;
+      estimate = std::max(estimate, std::abs(difference(i)) / std::max(1.0, std::abs(x(i))));  // [-]
+    }
+    return estimate;
   }
 
  private:
   static constexpr double kTwoPi = 6.283185307179586476925286766559;
+  /// The components a row's estimate judges: z and the passive coordinates up to the wheel angles;
+  /// not the applied work W and impulse I2 after them, quadratures for the balance diagnostics (the
+  /// scene's accuracy guard judges those balances on every row).
+  static constexpr int kConfigurationEnd = System::kDimension + kAppliedWorkIndex;
 
   HermiteDenseOutput<kSize, Points> history_{Points};
   AngleTurns<System> turns_{};  ///< of the newest point [-]

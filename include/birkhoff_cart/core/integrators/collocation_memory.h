@@ -124,18 +124,22 @@ struct CollocationMemory {
 
   /// A side step's memory from the grid's (`grid`, after its last accepted step): that step's stage
   /// points, for starting values (eq. (B.32)), and J, without cached inverses or end rates; the solve
-  /// stops at `limit` (stage_change_limit). With `keep_own_jacobian` (an earlier side step inside the
-  /// same grid step left one) this memory's J stands in where the grid has none.
-  void start_side_step_from(const CollocationMemory& grid, double limit, bool keep_own_jacobian) {
-    const bool keep = keep_own_jacobian && jacobian_valid && !grid.jacobian_valid;
-    const Eigen::Matrix<double, kDimension, kDimension> own = jacobian;
+  /// stops at `limit` (stage_change_limit). Where the grid has no J, `stand_in` (when given) is taken:
+  /// the side steps' own J from the grid point before (the same whichever instant asks first, so a
+  /// side step's result depends on the grid and its instant only).
+  void start_side_step_from(const CollocationMemory& grid, double limit,
+                            const Eigen::Matrix<double, kDimension, kDimension>* stand_in) {
     copy_history_from(grid);
-    if (keep) {
-      jacobian = own;
-      jacobian_valid = true;
-    }
+    if (!jacobian_valid && stand_in != nullptr) set_jacobian(*stand_in);
     forget_end_rate();
     stage_change_limit = limit;
+  }
+  /// J = ∂ẇ/∂w from elsewhere (a side step's), without cached inverses.
+  void set_jacobian(const Eigen::Matrix<double, kDimension, kDimension>& given) {
+    jacobian = given;
+    jacobian_valid = true;
+    cached = 0;
+    next_slot = 0;
   }
 
   /// The stage history and J of `other`, without its cached inverses (a side step's copy: the
