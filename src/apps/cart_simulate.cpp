@@ -48,6 +48,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -369,8 +370,18 @@ void apply_overrides(const std::map<std::string, std::string>& arguments, Scene&
   if (controlled) scene.integrator.step_size = 1.0 / scene.output_rate;
 }
 
-/// The scene key a time limit blames, with the option that may have set it.
-std::string key_with_option(const std::string& key) {
+/// The scene key a time limit blames, with the option that may have set it. Under a step control
+/// the step h the limits read is the rows' interval 1/HZ (apply_overrides), so they name --output-rate.
+std::string key_with_option(const std::string& key, const Scene& scene) {
+  const bool controlled = scene.integrator.step_control != birkhoff_cart::StepControl::kFixed;
+  if (controlled) {
+    std::ostringstream rate;
+    rate.precision(17);
+    rate << "output rate " << scene.output_rate << " Hz (--output-rate): under a step control h is the rows' interval "
+         << scene.integrator.step_size << " s";
+    if (key == "integrator.step_size") return "output_rate (" + rate.str() + ")";
+    if (key == "duration") return "duration (--duration) with the " + rate.str();
+  }
   if (key == "duration") return "duration (--duration)";
   if (key == "integrator.step_size") return "integrator.step_size (--step)";
   return key;
@@ -523,7 +534,7 @@ int run(int argc, char** argv) {
     guarded_run->require_output_instants_on_steps();
   } catch (const birkhoff_cart::TimeLimitError& error) {
     std::fprintf(stderr, "cart_simulate: scene %s with the given options: key '%s': %s\n", scene.source_path.c_str(),
-                 key_with_option(error.key()).c_str(), error.problem().c_str());
+                 key_with_option(error.key(), scene).c_str(), error.problem().c_str());
     return kExitSettings;
   } catch (const std::exception& error) {
     std::fprintf(stderr, "cart_simulate: %s\n", error.what());

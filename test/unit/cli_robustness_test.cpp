@@ -101,6 +101,27 @@ TEST(CartSimulateRobustness, ADopri5ToleranceBelowTheFloorIsRefused) {
   std::remove(temp_path("never.csv").c_str());
 }
 
+TEST(CartSimulateRobustness, AnOutputRateOutOfReachUnderAStepControlIsRefusedNamingTheOutputRate) {
+  // Under a step control h is the rows' interval 1/HZ: the time limits blamed 'duration (--duration)'
+  // and a step h the user never gave (1e-300 s for --output-rate 1e300; 1e6 s for 1e-6).
+  for (const char* rate : {"1e300", "1e-6"}) {
+    const Outcome outcome = run("--scene '" + scene_path("free_coast") +
+                                "' --integrator birkhoff_gauss8 --step-control adaptive --position-tolerance 1e-6 "
+                                "--output-rate " + rate + " --output '" + temp_path("never.csv") + "'");
+    EXPECT_EQ(outcome.exit_status, 3) << rate << ": " << outcome.standard_error;
+    EXPECT_NE(outcome.standard_error.find("(--output-rate): under a step control h is the rows' interval"),
+              std::string::npos)
+        << rate << ": " << outcome.standard_error;
+  }
+  // At fixed steps a rate whose rows fall between the steps names both options.
+  const Outcome fixed = run("--scene '" + scene_path("free_coast") + "' --output-rate 1e9 --output '" +
+                            temp_path("never.csv") + "'");
+  EXPECT_EQ(fixed.exit_status, 3) << fixed.standard_error;
+  EXPECT_NE(fixed.standard_error.find("(--output-rate) puts rows between the fixed steps"), std::string::npos)
+      << fixed.standard_error;
+  std::remove(temp_path("never.csv").c_str());
+}
+
 TEST(CartSimulateRobustness, AnOutputRateWithAHugeStepCountIsRefused) {
   // 1/HZ = 1e300 s is 1e303 steps: lround of that was UB.
   const Outcome outcome = run("--scene '" + scene_path("free_coast") + "' --output-rate 1e-300 --output '" +
