@@ -223,8 +223,9 @@ std::string usage() {
          "Every option also takes the form --option=value.\n"
          "The rows are at t0 + k/HZ from the start to the end, both included; when the duration is not a\n"
          "whole number of output intervals, a last row is written at the end time t0 + T itself (reached\n"
-         "by one shorter final step). Scene times are limited so that t + H stays exact to ~1e-6 H\n"
-         "(docs/scenes.md). Runs longer than a second report progress on stderr (once a second at most).\n"
+         "by one shorter final step); at most 1e8 rows a run. Scene times are limited so that t + H stays\n"
+         "exact to ~1e-6 H (docs/scenes.md). Runs longer than a second report progress on stderr (once a\n"
+         "second at most).\n"
          "Exit status: 0 done; 2 bad arguments; 3 unusable scene, settings or output file;\n"
          "4 a step failed or the run stopped (the rows written so far are kept); 5 the accuracy guard\n"
          "reached ERROR (docs/accuracy.md; the summary on stdout names the quantity).\n";
@@ -366,8 +367,28 @@ void apply_overrides(const std::map<std::string, std::string>& arguments, Scene&
                      " the member chooses its own steps and the rows come at --output-rate HZ");
   }
   // Under a step control the output step is the row interval: the rows need not fall on any step
-  // of the member's (its dense output), so the scene's step_size does not constrain them.
-  if (controlled) scene.integrator.step_size = 1.0 / scene.output_rate;
+  // of the member's (its dense output), so the scene's step_size does not constrain them. A row
+  // interval beyond the run leaves the rows at its start and end, as at fixed steps.
+  if (controlled) {
+    if (1.0 / scene.output_rate > scene.duration) scene.output_rate = 1.0 / scene.duration;
+    scene.integrator.step_size = 1.0 / scene.output_rate;
+  }
+}
+
+/// The most rows one run writes: 10^8 rows are about 30 GB of CSV.
+constexpr double kMaxRows = 1e8;
+
+/// Refuses a run whose rows (output_rate × duration + 1) exceed kMaxRows, naming the rate and the
+/// duration: --output-rate 1e9 over 6 s started 6·10⁹ rows and filled the disk.
+void require_row_count(const Scene& scene) {
+  const double rows = std::floor(scene.output_rate * scene.duration) + 1.0;  // [-]
+  if (rows <= kMaxRows) return;
+  std::ostringstream message;
+  message.precision(17);
+  message << "output_rate " << scene.output_rate << " Hz (--output-rate) over duration " << scene.duration
+          << " s (--duration) asks for " << rows << " rows, more than the limit of " << kMaxRows
+          << " (about 300 bytes of CSV each): a lower --output-rate or a shorter --duration";
+  throw std::invalid_argument(message.str());
 }
 
 /// The scene key a time limit blames, with the option that may have set it. Under a step control
@@ -381,6 +402,7 @@ std::string key_with_option(const std::string& key, const Scene& scene) {
          << scene.integrator.step_size << " s";
     if (key == "integrator.step_size") return "output_rate (" + rate.str() + ")";
     if (key == "duration") return "duration (--duration) with the " + rate.str();
+    return key + " with the " + rate.str();
   }
   if (key == "duration") return "duration (--duration)";
   if (key == "integrator.step_size") return "integrator.step_size (--step)";
@@ -532,6 +554,7 @@ int run(int argc, char** argv) {
     const std::string drift = birkhoff_cart::paper_form_drift_warning(scene);  // the eᵗ form's h² drift
     if (!drift.empty()) std::fprintf(stderr, "cart_simulate: %s\n", drift.c_str());
     guarded_run->require_output_instants_on_steps();
+    require_row_count(scene);
   } catch (const birkhoff_cart::TimeLimitError& error) {
     std::fprintf(stderr, "cart_simulate: scene %s with the given options: key '%s': %s\n", scene.source_path.c_str(),
                  key_with_option(error.key(), scene).c_str(), error.problem().c_str());

@@ -90,6 +90,13 @@ TEST(PaperFormDrift, PredictedGrowthIsWhatARunShowsAndTheWarningFiresOnlyWhenItM
   EXPECT_NE(warning.find("autonomous"), std::string::npos) << warning;
   EXPECT_EQ(paper_form_drift_warning(scene("birkhoff2", BirkhoffianForm::kPaper, kStep, 1.0)), "");
   EXPECT_EQ(paper_form_drift_warning(scene("midpoint", BirkhoffianForm::kPaper, kStep, 1e4)), "");
+  // Under a step control step_size is the rows' interval, not a step of the member's: no warning
+  // (gauss4 adaptive on paper_special with rows at 1 Hz warned of its "h = 1 s").
+  Scene controlled = scene("birkhoff_gauss4", BirkhoffianForm::kPaper, 1.0, kDuration);
+  EXPECT_NE(paper_form_drift_warning(controlled), "") << "the test needs a case that warns at fixed steps";
+  controlled.integrator.step_control = StepControl::kAdaptive;
+  controlled.integrator.position_tolerance = 1e-6;
+  EXPECT_EQ(paper_form_drift_warning(controlled), "");
 }
 
 /// What the eᵗ form does to the free whirl over 1000 s at h = 0.01 s, read every second as

@@ -43,6 +43,9 @@ double paper_form_momentum_growth(const Scene& scene, double duration) {
 
 std::string paper_form_drift_warning(const Scene& scene) {
   if (scene.integrator.birkhoffian_form != BirkhoffianForm::kPaper) return "";
+  // The drift is a fixed step's: under a step control the member's own steps follow the tolerance,
+  // and integrator.step_size is the rows' interval, which says nothing of them.
+  if (scene.integrator.step_control != StepControl::kFixed) return "";
   const double growth = paper_form_momentum_growth(scene, scene.duration);
   if (!(std::abs(growth) > kPaperFormDriftWarningThreshold)) return "";
   std::ostringstream message;
