@@ -223,6 +223,9 @@ py::dict statistics_dict(const StepStatistics& statistics) {
   counts["passive_evaluations"] = statistics.passive_evaluations;
   counts["newton_iterations"] = statistics.newton_iterations_total;
   counts["internal_steps"] = statistics.internal_steps;
+  // Attempts a step control rejected (the reversible control: its restarts with a smaller ε; at fixed
+  // steps, the steps taken in substeps): the rejected share is rejected_steps / internal_steps.
+  counts["rejected_steps"] = statistics.rejected_steps;
   counts["local_error_estimate_max"] = statistics.local_error_estimate_max;
   counts["local_error_estimate_sum"] = statistics.local_error_estimate_sum;
   // The adaptive control's global error estimate (docs/accuracy.md §4.5): NaN when not asked for.

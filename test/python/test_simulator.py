@@ -13,6 +13,7 @@ import json
 import math
 import os
 import pathlib
+import re
 import subprocess
 import sys
 
@@ -122,6 +123,23 @@ def test_the_registry_is_the_cli_s():
     # estimates do not follow their error, are refused under it (accuracy.md §4.4).
     adaptive = {member["name"] for member in members if member["adaptive"]}
     assert adaptive == {name for name in birkhoffian if name.startswith("birkhoff_gauss")} | {"dopri5"}
+
+
+def test_the_rejected_steps_are_the_cli_s(tmp_path):
+    # The rejected attempts of a step control, as cart_simulate's summary counts them ("N rejected").
+    scene = simulator.load_scene(scene_path("paper_special"), {"reference": None, "integrator": {
+        "name": "birkhoff_gauss8", "step_control": "adaptive", "position_tolerance": 1e-3, "step_size": 0.1}})
+    simulation = simulator.Simulation(scene)
+    simulation.run()
+    counts = simulation.statistics()
+    cli = subprocess.run([str(BIN / "cart_simulate"), "--scene", scene_path("paper_special"), "--integrator",
+                          "birkhoff_gauss8", "--step-control", "adaptive", "--position-tolerance", "1e-3",
+                          "--output-rate", "10", "--output", str(tmp_path / "out.csv")],
+                         capture_output=True, text=True)
+    summary = re.search(r"(\d+) internal steps .*, (\d+) rejected", cli.stdout)
+    assert summary, cli.stdout
+    assert (counts["internal_steps"], counts["rejected_steps"]) == (int(summary[1]), int(summary[2]))
+    assert counts["rejected_steps"] > 0  # paper_special rejects at 1e-3 m (accuracy.md §4.3)
 
 
 def test_the_global_error_estimate_is_in_the_statistics_when_asked_for():
