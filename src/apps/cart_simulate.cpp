@@ -375,6 +375,21 @@ void apply_overrides(const std::map<std::string, std::string>& arguments, Scene&
   }
 }
 
+/// At fixed steps the rows must fall on steps: a rate whose interval is no whole number of them is
+/// refused naming --output-rate and --step.
+void require_rows_on_steps(const birkhoff_cart::GuardedRun& guarded_run, const Scene& scene) {
+  try {
+    guarded_run.require_output_instants_on_steps();
+  } catch (const std::invalid_argument& error) {
+    std::ostringstream message;
+    message.precision(17);
+    message << "output_rate " << scene.output_rate << " Hz (--output-rate) puts rows between the fixed steps of "
+            << "integrator.step_size " << scene.integrator.step_size << " s (--step): " << error.what()
+            << "; choose a rate whose row interval is a whole number of steps, or a step control";
+    throw std::invalid_argument(message.str());
+  }
+}
+
 /// The most rows one run writes: 10^8 rows are about 30 GB of CSV.
 constexpr double kMaxRows = 1e8;
 
@@ -553,7 +568,7 @@ int run(int argc, char** argv) {
     guarded_run = std::make_unique<birkhoff_cart::GuardedRun>(scene);
     const std::string drift = birkhoff_cart::paper_form_drift_warning(scene);  // the eᵗ form's h² drift
     if (!drift.empty()) std::fprintf(stderr, "cart_simulate: %s\n", drift.c_str());
-    guarded_run->require_output_instants_on_steps();
+    require_rows_on_steps(*guarded_run, scene);
     require_row_count(scene);
   } catch (const birkhoff_cart::TimeLimitError& error) {
     std::fprintf(stderr, "cart_simulate: scene %s with the given options: key '%s': %s\n", scene.source_path.c_str(),

@@ -52,6 +52,7 @@ class AdaptiveCartStepperAdapter final
   using Base::dense_;
   using Base::instants_;
   using Base::output_;
+  using Base::position_tolerance_;
   using Base::system_;
   /// The work limit: internal steps between two output instants (as dopri5's, DOPRI5's NMAX).
   static constexpr std::uint64_t kMaxInternalStepsPerOutput = 100000;
@@ -63,8 +64,8 @@ class AdaptiveCartStepperAdapter final
   /// side steps to output instants step it.
   AdaptiveCartStepperAdapter(const Stepper& stepper, const Stepper& estimate_free_stepper, const IntegratorSettings& settings,
                              const CartModel& model, const EffectSet& effects)
-      : Base(model, effects, "adaptive"), effects_(&effects), control_(stepper, control_settings(settings)),
-        estimate_free_stepper_(estimate_free_stepper), position_tolerance_(settings.position_tolerance),
+      : Base(model, effects, "adaptive", settings.position_tolerance), effects_(&effects), control_(stepper, control_settings(settings)),
+        estimate_free_stepper_(estimate_free_stepper),
         global_error_estimate_(settings.global_error_estimate),
         stage_change_per_unit_step_(control_.settings().stage_change_fraction * control_.settings().error_per_unit_step) {}
 
@@ -194,16 +195,8 @@ class AdaptiveCartStepperAdapter final
       output_.point = grid.point;
       output_.turns = grid.turns;
     } else {
-      between_grid_points(target, output_, statistics);
+      this->between_grid_points(target, output_, statistics);
     }
-  }
-
-  /// The carried point at `target` inside the grid's newest step in `out`: the dense output, or a
-  /// side step where the dense output's own estimate exceeds the tolerance. Depends on the grid and
-  /// `target` only (the rows asked before do not change it), so a read by newest_step_state is the
-  /// row the run would output there.
-  void between_grid_points(double target, Output& out, StepStatistics& statistics) {
-    if (!(dense_.at(system_, target, out, statistics) <= position_tolerance_)) side_step(target, out, statistics);
   }
 
   /// The state at `target` by one step of the member from the grid point before it: exact to the
@@ -271,7 +264,6 @@ class AdaptiveCartStepperAdapter final
   /// The side steps' J where the grid has none: at the grid point before, of time side_jacobian_at_ [s].
   Eigen::Matrix<double, System::kDimension, System::kDimension> side_jacobian_;
   double side_jacobian_at_ = std::numeric_limits<double>::quiet_NaN();
-  double position_tolerance_;  ///< [m]
   bool global_error_estimate_;
   double stage_change_per_unit_step_;  ///< κ·τ: the stage solve stops at this·h [1/s] (B.49)
   RichardsonShadow<Stepper, System, Carried> shadow_;

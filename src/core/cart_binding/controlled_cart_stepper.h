@@ -39,7 +39,7 @@ class ControlledCartStepper : public CartStepper {
     Output probe = output_;
     probe.periodic_angles = system_traits::periodic_angles(system_);
     try {
-      derived().between_grid_points(time, probe, work);
+      between_grid_points(time, probe, work);
     } catch (const StepError& error) {
       throw StepError(name_ + " (" + control_name_ + " step control): " + error.what());
     }
@@ -80,9 +80,22 @@ class ControlledCartStepper : public CartStepper {
   /// member's own order 2m, estimates its error (grid_dense_output.h).
   static constexpr int kDensePoints = (Stepper::kOrder / 2 > 2 ? Stepper::kOrder / 2 : 2) + 1;
 
-  /// `control`: "adaptive" or "reversible", for messages.
-  ControlledCartStepper(const CartModel& model, const EffectSet& effects, const char* control)
-      : system_(model, effects), name_(Stepper::name()), control_name_(control), instants_(effects) {}
+  /// `control`: "adaptive" or "reversible", for messages; `position_tolerance` [m] judges the rows
+  /// between grid points.
+  ControlledCartStepper(const CartModel& model, const EffectSet& effects, const char* control,
+                        double position_tolerance)
+      : system_(model, effects), name_(Stepper::name()), control_name_(control), instants_(effects),
+        position_tolerance_(position_tolerance) {}
+
+  /// The carried point at `target` inside the grid's newest step in `out`: the dense output, or the
+  /// derived control's side_step(target, out, statistics) where the dense output's own estimate
+  /// exceeds the tolerance. Depends on the grid and `target` only (the rows asked before do not
+  /// change it), so a read by newest_step_state is the row the run would output there.
+  void between_grid_points(double target, Output& out, StepStatistics& statistics) {
+    if (!(dense_.at(system_, target, out, statistics) <= position_tolerance_)) {
+      derived().side_step(target, out, statistics);
+    }
+  }
 
   /// Defaults of the optional hooks: nothing more to do or check.
   void before_start(const CartState& /*state*/, StepStatistics& /*statistics*/) {}
@@ -105,6 +118,7 @@ class ControlledCartStepper : public CartStepper {
   GridObserver observer_;
   bool valid_ = false;
   OutputInstants instants_;
+  double position_tolerance_;  ///< [m]
 
  private:
   Derived& derived() { return static_cast<Derived&>(*this); }

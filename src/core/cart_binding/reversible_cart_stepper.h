@@ -56,7 +56,7 @@ class ReversibleCartStepperAdapter final
 
   ReversibleCartStepperAdapter(const Stepper& stepper, const IntegratorSettings& settings, const CartModel& model,
                                const EffectSet& effects)
-      : Base(model, effects, "reversible"), transformed_(system_, 0.0, stiff_density_squared(model, effects)),
+      : Base(model, effects, "reversible", settings.position_tolerance), transformed_(system_, 0.0, stiff_density_squared(model, effects)),
         settings_(settings),
         control_(stepper, transformed_, stepper_checks::error_per_unit_step(settings, "reversible"),
                  settings.tolerance_horizon) {
@@ -147,16 +147,8 @@ class ReversibleCartStepperAdapter final
     } else if (land) {
       landing_step(target, output_, statistics);
     } else {
-      between_grid_points(target, output_, statistics);
+      this->between_grid_points(target, output_, statistics);
     }
-  }
-
-  /// The carried point at `target` inside the grid's newest step in `out`: the dense output, or a
-  /// side step where the dense output's own estimate exceeds the tolerance. Depends on the grid and
-  /// `target` only (the rows asked before do not change it), so a read by newest_step_state is the
-  /// row the run would output there.
-  void between_grid_points(double target, Output& out, StepStatistics& statistics) {
-    if (!(dense_.at(system_, target, out, statistics) <= settings_.position_tolerance)) side_step(target, out, statistics);
   }
 
   /// The state at a landing instant `target` (the run's end, a land_on() instant, a command's): a
@@ -208,7 +200,6 @@ class ReversibleCartStepperAdapter final
   IntegratorSettings settings_;
   Control control_;
   SideMemory side_memory_;  ///< a side step's (kept: it is large; cleared for each)
-
 };
 
 }  // namespace birkhoff_cart
