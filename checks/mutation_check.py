@@ -104,8 +104,9 @@ MUTATIONS = [
         "passive_rates_at_first_stage",
         "the passive coordinates (x, y, θ, φ) are integrated with every stage's rate taken at the first stage",
         "include/birkhoff_cart/core/integrators/passive_quadrature.h",
-        "passive_rates[j] = passive_coordinate_rates(system, stage_points[j], passive_stages[j], S(stage_times[j]));",
-        "passive_rates[j] = passive_coordinate_rates(system, stage_points[0], passive_stages[0], S(stage_times[0]));",
+        "system.passive_rates_stages(stage_points, passive_stages, stage_times, passive_rates);",
+        "system.passive_rates_stages(stage_points, passive_stages, stage_times, passive_rates);\n"
+        "          for (int j = 1; j < Stages; ++j) passive_rates[j] = passive_rates[0];",
         [(TRAJECTORY, "*"), ("integrator_contract_test", "*")],
     ),
     Mutation(
@@ -138,10 +139,8 @@ MUTATIONS = [
         "time_transform_passive_rates",
         "the time transformation scales ż by 1/σ but not the passive rates ẏ (positions advance in fictive time)",
         "include/birkhoff_cart/core/integrators/time_transformed_system.h",
-        "passive_coordinate_rates(*system_, z, BasePassive<S>(y.template head<System::kPassiveDimension>()), t) *\n"
-        "        inverse_density;",
-        "passive_coordinate_rates(*system_, z, BasePassive<S>(y.template head<System::kPassiveDimension>()), t) *\n"
-        "        S(1.0);",
+        "rate.template head<System::kPassiveDimension>() = rates * inverse_density;",
+        "rate.template head<System::kPassiveDimension>() = rates * S(1.0);",
         [("reversible_step_control_test", "*")],
     ),
     Mutation(

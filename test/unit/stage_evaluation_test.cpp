@@ -14,9 +14,14 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
+#include "all_effects.h"
 #include "birkhoff_cart/core/physics/cart_birkhoffian.h"
+#include "birkhoff_cart/core/physics/effect_library.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
+#include "birkhoff_cart/core/integrators/gauss_collocation.h"
+#include "birkhoff_cart/core/integrators/time_transformed_system.h"
 #include "birkhoff_cart/core/integrators/deterministic_math.h"
 #include "birkhoff_cart/core/scene/scene.h"
 #include "birkhoff_cart/core/integrators/vector_math.h"
@@ -142,6 +147,185 @@ TEST_F(StageEvaluationTest, StageRatesOnTheScalarPathAreThePointwiseRates) {
   for (int j = 0; j < 3; ++j) EXPECT_EQ(rates[j], autonomous.darboux_rates(points[j], times[j]));
   paper.darboux_rates_stages(points, times, rates);
   for (int j = 0; j < 3; ++j) EXPECT_EQ(rates[j], paper.darboux_rates(points[j], times[j]));
+}
+
+/// Bits of the passive rates of `stages` against `pointwise`: the entries that differ.
+template <class Passive, std::size_t Count>
+long differing_entries(const std::array<Passive, Count>& stages, const std::array<Passive, Count>& pointwise) {
+  long differing = 0;
+  for (std::size_t j = 0; j < Count; ++j) {
+    for (int k = 0; k < Passive::RowsAtCompileTime; ++k) differing += !same_bits(stages[j](k), pointwise[j](k));
+  }
+  return differing;
+}
+
+/// passive_rates_stages, passive_coupling_rates_stages and darboux_rates_stages of `system` (the
+/// cart, or the cart in fictive time, whose rates divide by the step density of each stage) against
+/// passive_rates, passive_coupling_rates and darboux_rates stage by stage, on `trials` random sets of
+/// four stages: the entries whose bits differ.
+template <class System>
+long passive_stage_rates_differing(const System& system, unsigned seed, int trials) {
+  using Vector = typename System::template Vector<double>;
+  using Passive = typename System::template Passive<double>;
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> steering(-1.4, 1.4), momentum(-300.0, 300.0), heading(-40.0, 40.0),
+      unit(-1.0, 1.0);
+  long differing = 0;
+  for (int trial = 0; trial < trials; ++trial) {
+    std::array<Vector, 4> points;
+    std::array<Passive, 4> passive;
+    std::array<double, 4> times;
+    for (int j = 0; j < 4; ++j) {
+      points[j] = Vector(unit(random), steering(random), momentum(random), momentum(random) / 10);
+      passive[j] = Passive::Constant(0.0);
+      for (int k = 0; k < Passive::RowsAtCompileTime; ++k) passive[j](k) = 10.0 * unit(random);
+      passive[j](kHeadingIndex) = heading(random);
+      times[j] = 2.0 + 0.01 * j;
+    }
+    std::array<Passive, 4> together;
+    std::array<Passive, 4> one_by_one;
+    system.passive_rates_stages(points, passive, times, together);
+    for (int j = 0; j < 4; ++j) one_by_one[j] = system.passive_rates(points[j], passive[j], times[j]);
+    differing += differing_entries(together, one_by_one);
+    system.passive_coupling_rates_stages(points, times, together);
+    for (int j = 0; j < 4; ++j) one_by_one[j] = system.passive_coupling_rates(points[j], times[j]);
+    differing += differing_entries(together, one_by_one);
+    std::array<Vector, 4> rates_together;
+    std::array<Vector, 4> rates_one_by_one;
+    system.darboux_rates_stages(points, times, rates_together);
+    for (int j = 0; j < 4; ++j) rates_one_by_one[j] = system.darboux_rates(points[j], times[j]);
+    differing += differing_entries(rates_together, rates_one_by_one);
+  }
+  return differing;
+}
+
+/// The cart under every load (so that the work and impulse rates read them), in time and in the
+/// reversible control's fictive time (a stiff density 400 s⁻² as a hinge spring's), built in place:
+/// its systems point at its own model and effects.
+struct LoadedCart {
+  LoadedCart() = default;
+  LoadedCart(const LoadedCart&) = delete;
+  LoadedCart& operator=(const LoadedCart&) = delete;
+  const CartModel model{CartParameters{}};
+  const EffectSet effects = build_effects(birkhoff_cart_test::all_effect_specs(), model);
+  const CartAutonomousBirkhoffian autonomous{model, effects};
+  const TimeTransformedSystem<CartAutonomousBirkhoffian> fictive{autonomous, 2.0, 400.0};
+};
+
+// The passive quadrature's one call a sweep (passive_quadrature.h) is g stage by stage bit for bit,
+// with every load on (so the work and impulse rates read them), on both paths, for the cart in
+// time and in the reversible control's fictive time (there the stages' step densities come from one
+// call too, in the rates of every iteration).
+TEST_F(StageEvaluationTest, PassiveStageRatesAreThePointwiseRatesBitForBitOnBothPaths) {
+  const LoadedCart cart;
+  CartPaperBirkhoffian paper(cart.model, cart.effects);
+  paper.begin_step(2.0);
+  std::vector<StageEvaluation> paths = {StageEvaluation::kScalar};
+  if (vector_stage_evaluation_available()) paths.push_back(StageEvaluation::kVector);
+  for (const StageEvaluation path : paths) {
+    set_stage_evaluation(path);
+    const long in_time =
+        passive_stage_rates_differing(cart.autonomous, 11, 2000) + passive_stage_rates_differing(paper, 12, 2000);
+    const long in_fictive_time = passive_stage_rates_differing(cart.fictive, 13, 2000);
+    std::printf("[ compared ] %s path: passive rates of 2000 x 4 stages together vs one by one, bits of every entry: "
+                "%ld differ in time, %ld in fictive time (with its stage rates)\n",
+                to_string(path).c_str(), in_time, in_fictive_time);
+    EXPECT_EQ(in_time, 0);
+    EXPECT_EQ(in_fictive_time, 0);
+  }
+}
+
+/// darboux_and_passive_rates of `system` against darboux_rates and passive_rates at `trials` random
+/// points: the entries whose bits differ.
+template <class System>
+long shared_end_rates_differing(const System& system, unsigned seed, int trials) {
+  using Vector = typename System::template Vector<double>;
+  using Passive = typename System::template Passive<double>;
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> steering(-1.4, 1.4), momentum(-300.0, 300.0), unit(-1.0, 1.0);
+  long differing = 0;
+  for (int trial = 0; trial < trials; ++trial) {
+    const Vector w(unit(random), steering(random), momentum(random), momentum(random) / 10);
+    Passive y = Passive::Constant(0.0);
+    for (int k = 0; k < Passive::RowsAtCompileTime; ++k) y(k) = 10.0 * unit(random);
+    const double t = 2.0 + unit(random);
+    Vector rate;
+    Passive passive;
+    system.darboux_and_passive_rates(w, y, t, rate, passive);
+    const Vector rate_alone = system.darboux_rates(w, t);
+    const Passive passive_alone = system.passive_rates(w, y, t);
+    for (int k = 0; k < Vector::RowsAtCompileTime; ++k) differing += !same_bits(rate(k), rate_alone(k));
+    for (int k = 0; k < Passive::RowsAtCompileTime; ++k) differing += !same_bits(passive(k), passive_alone(k));
+  }
+  return differing;
+}
+
+// The local error estimate's F(w⁺) and g(z⁺, y⁺) from one shared evaluation (collocation_error_estimate.h)
+// are the two calls bit for bit: under every load, with the non-Birkhoffian force off, and in the
+// reversible control's fictive time.
+TEST_F(StageEvaluationTest, SharedEndRatesAreTheTwoCallsBitForBit) {
+  const LoadedCart cart;
+  CartAutonomousBirkhoffian force_off(cart.model, cart.effects);
+  force_off.set_non_birkhoffian_force_enabled(false);
+  const long in_time =
+      shared_end_rates_differing(cart.autonomous, 21, 4000) + shared_end_rates_differing(force_off, 22, 4000);
+  const long in_fictive_time = shared_end_rates_differing(cart.fictive, 23, 4000);
+  std::printf("[ compared ] darboux_and_passive_rates vs darboux_rates and passive_rates at 3 x 4000 points, bits of "
+              "every entry: %ld differ in time (loads on and off), %ld in fictive time\n",
+              in_time, in_fictive_time);
+  EXPECT_EQ(in_time, 0);
+  EXPECT_EQ(in_fictive_time, 0);
+}
+
+/// The cart with every hook but its shared evaluations, which it hides: the passive quadrature then
+/// evaluates g stage by stage, and the local error estimate F(w⁺) and g(z⁺, y⁺) apart.
+class CartWithoutSharedRates : public CartAutonomousBirkhoffian {
+ public:
+  using CartAutonomousBirkhoffian::CartAutonomousBirkhoffian;
+  void passive_rates_stages() const = delete;
+  void passive_coupling_rates_stages() const = delete;
+  void darboux_and_passive_rates() const = delete;
+};
+
+// A whole collocation run with the shared evaluations (the stage-batched passive rates, the end
+// rates of the local error estimate) is the run without them, bit for bit, estimate included: the
+// hooks change the cost only (gauss8, 160 steps of 0.05 s under every load).
+TEST_F(StageEvaluationTest, PassiveQuadratureWithTheStageHookIsTheRunWithoutItBitForBit) {
+  static_assert(system_traits::kHasPassiveStageRates<CartAutonomousBirkhoffian, 4>);
+  static_assert(system_traits::kHasDarbouxAndPassiveRates<CartAutonomousBirkhoffian>);
+  static_assert(!system_traits::kHasPassiveStageRates<CartWithoutSharedRates, 4>);
+  static_assert(!system_traits::kHasDarbouxAndPassiveRates<CartWithoutSharedRates>);
+  const LoadedCart cart;
+  const CartAutonomousBirkhoffian& with_hook = cart.autonomous;
+  const CartWithoutSharedRates without_hook(cart.model, cart.effects);
+  const GaussCollocation<4> gauss8;
+  Eigen::Vector4d z_with(0.0, 0.3, 40.0, 2.0);
+  Eigen::Matrix<double, CartAutonomousBirkhoffian::kPassiveDimension, 1> y_with =
+      Eigen::Matrix<double, CartAutonomousBirkhoffian::kPassiveDimension, 1>::Zero();
+  y_with(kHeadingIndex) = 0.5;
+  Eigen::Vector4d z_without = z_with;
+  auto y_without = y_with;
+  StepStatistics with_statistics;
+  StepStatistics without_statistics;
+  for (int k = 0; k < 160; ++k) {
+    gauss8.step(with_hook, z_with, y_with, 0.05 * k, 0.05, with_statistics);
+    gauss8.step(without_hook, z_without, y_without, 0.05 * k, 0.05, without_statistics);
+  }
+  long differing = 0;
+  for (int k = 0; k < 4; ++k) differing += !same_bits(z_with(k), z_without(k));
+  for (int k = 0; k < y_with.size(); ++k) differing += !same_bits(y_with(k), y_without(k));
+  differing += !same_bits(with_statistics.local_error_estimate_max, without_statistics.local_error_estimate_max);
+  differing += !same_bits(with_statistics.local_error_estimate_sum, without_statistics.local_error_estimate_sum);
+  std::printf("[ compared ] gauss8, 160 steps under every load: bits of z, y and the estimate's max and sum with and "
+              "without the shared evaluations: %ld of %d differ (x %.17g m, largest estimate %.3g); passive "
+              "evaluations %llu and %llu\n",
+              differing, 6 + static_cast<int>(y_with.size()), y_with(0), with_statistics.local_error_estimate_max,
+              static_cast<unsigned long long>(with_statistics.passive_evaluations),
+              static_cast<unsigned long long>(without_statistics.passive_evaluations));
+  EXPECT_EQ(differing, 0);
+  EXPECT_EQ(with_statistics.passive_evaluations, without_statistics.passive_evaluations);
+  EXPECT_TRUE(std::isfinite(y_with(0)) && y_with(0) != 0.0) << "the run moved nowhere: nothing compared";
+  EXPECT_GT(with_statistics.local_error_estimate_max, 0.0) << "no estimate was made: the end rates were not compared";
 }
 
 /// The whirl over `duration` [s] with `integrator` at h = 0.02 s on the path in use.

@@ -5,7 +5,8 @@
 // classical O(h³) estimate of its own error (within a factor 3 of the true local error on the paper
 // case); s ≥ 2: O(h^{s+2}), a conservative bound of the O(h^{2s+1}) error. The same on g for the
 // passive coordinates. Cost: one rhs evaluation F(w⁺) and one passive evaluation g(z⁺, y⁺) a step
-// (first same as last: they are the next step's F(w) and g(z, y)). It vanishes identically on linear
+// (first same as last: they are the next step's F(w) and g(z, y)), from one evaluation of what they
+// share where the system offers it (darboux_and_passive_rates, system_traits.h). It vanishes identically on linear
 // autonomous ẇ = Lw (the defect is then a multiple of the node polynomial, whose end values cancel).
 #pragma once
 
@@ -14,6 +15,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include "birkhoff_cart/core/integrators/autodiff.h"
 #include "birkhoff_cart/core/integrators/birkhoffian_system.h"
@@ -55,7 +57,18 @@ LocalErrorVectors<System, S> collocation_error_vectors(const System& system, con
   using Y = PassiveVector<System, S>;
   const std::array<double, kMaxGaussStages + 2>& eta = tableau.estimate_weights;
   const double t_next = t + h;
-  const W end_rate = system.darboux_rates(w_next, S(t_next));  // F(w⁺, tₖ₊₁)
+  // F(w⁺, tₖ₊₁), and g(z⁺, y⁺, tₖ₊₁) with it where the system shares their work (w = z: the identity
+  // chart; system_traits.h), bit for bit the two calls.
+  constexpr bool kEndRatesTogether = std::is_same_v<S, double> && System::kPassiveDimension > 0 &&
+                                     system_traits::kDarbouxChartIsIdentity<System> &&
+                                     system_traits::kHasDarbouxAndPassiveRates<System>;
+  W end_rate;
+  Y end_passive_rate_together;
+  if constexpr (kEndRatesTogether) {
+    system.darboux_and_passive_rates(w_next, y_next, t_next, end_rate, end_passive_rate_together);
+  } else {
+    end_rate = system.darboux_rates(w_next, S(t_next));
+  }
   ++statistics.rhs_evaluations;
   memory.end_rate_valid = true;
   memory.end_time = t_next;
@@ -102,7 +115,12 @@ LocalErrorVectors<System, S> collocation_error_vectors(const System& system, con
       start_passive_rate = passive_coordinate_rates(system, z_start, y_start, S(t));
       ++statistics.passive_evaluations;
     }
-    const Y end_passive_rate = passive_coordinate_rates(system, z_next, y_next, S(t_next));
+    Y end_passive_rate;
+    if constexpr (kEndRatesTogether) {
+      end_passive_rate = end_passive_rate_together;
+    } else {
+      end_passive_rate = passive_coordinate_rates(system, z_next, y_next, S(t_next));
+    }
     ++statistics.passive_evaluations;
     memory.end_passive_point = values_of(y_next);
     memory.end_passive_rate = values_of(end_passive_rate);

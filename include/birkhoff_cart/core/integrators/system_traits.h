@@ -14,6 +14,11 @@
 //   darboux_jacobian(w, t)                        forward-mode AD    the simplified-Newton matrix J = ∂ẇ/∂w
 //   darboux_rates_stages(w[s], t[s], F[s])        s calls of ẇ       one call for an iteration's s stages
 //   passive_coupling_rates(z, t)                  the full g         the first d passive sweeps
+//   darboux_and_passive_rates(w, y, t, F, G)      ẇ and g apart      the estimate's F(w⁺) and g(z⁺, y⁺) (identity
+//                                                                    chart): sin χ, ω and the loads once
+//   passive_rates_stages(z[s], y[s], t[s], G[s])  s calls of g and   the passive quadrature's sweeps over the s
+//   passive_coupling_rates_stages(z[s], t[s],     of the coupling    stages in one call each (the same bits)
+//     G[s])                                       rates
 //   static constexpr std::array<AngleCoordinate,  none               the carried point (carried_point.h): each
 //     N> kAngleCoordinates                                           angle [rad] kept in (−π, π] with its whole
 //                                                                    turns apart, so its ulp does not grow
@@ -118,7 +123,37 @@ struct HasStageRates<System, Stages,
                          std::declval<const std::array<StateVector<System, double>, Stages>&>(),
                          std::declval<const std::array<double, Stages>&>(),
                          std::declval<std::array<StateVector<System, double>, Stages>&>()))>> : std::true_type {};
+
+template <class System, int Stages, class = void>
+struct HasPassiveStageRates : std::false_type {};
+template <class System, int Stages>
+struct HasPassiveStageRates<
+    System, Stages,
+    std::void_t<decltype(std::declval<const System&>().passive_rates_stages(
+                    std::declval<const std::array<StateVector<System, double>, Stages>&>(),
+                    std::declval<const std::array<PassiveVector<System, double>, Stages>&>(),
+                    std::declval<const std::array<double, Stages>&>(),
+                    std::declval<std::array<PassiveVector<System, double>, Stages>&>())),
+                decltype(std::declval<const System&>().passive_coupling_rates_stages(
+                    std::declval<const std::array<StateVector<System, double>, Stages>&>(),
+                    std::declval<const std::array<double, Stages>&>(),
+                    std::declval<std::array<PassiveVector<System, double>, Stages>&>()))>> : std::true_type {};
+
+template <class System, class = void>
+struct HasDarbouxAndPassiveRates : std::false_type {};
+template <class System>
+struct HasDarbouxAndPassiveRates<System, std::void_t<decltype(std::declval<const System&>().darboux_and_passive_rates(
+                                             std::declval<const StateVector<System, double>&>(),
+                                             std::declval<const PassiveVector<System, double>&>(), 0.0,
+                                             std::declval<StateVector<System, double>&>(),
+                                             std::declval<PassiveVector<System, double>&>()))>> : std::true_type {};
 }  // namespace detail
+
+/// The system gives ẇ and g at one point of its identity chart from one evaluation of what they
+/// share (darboux_and_passive_rates(w, y, t, ẇ, g)), bit for bit darboux_rates and passive_rates:
+/// the local error estimate's rates at a step's end.
+template <class System>
+constexpr bool kHasDarbouxAndPassiveRates = detail::HasDarbouxAndPassiveRates<System>::value;
 
 /// The coordinates no rate reads (bit k: coordinate k of z), e.g. the cart's arc length π1.
 template <class System>
@@ -148,6 +183,12 @@ constexpr bool kHasDarbouxJacobian = detail::HasDarbouxJacobian<System>::value;
 /// The system evaluates ẇ at all s stages of an iteration at once (darboux_rates_stages).
 template <class System, int Stages>
 constexpr bool kHasStageRates = detail::HasStageRates<System, Stages>::value;
+
+/// The system evaluates g (passive_rates) and the coupling rates (passive_coupling_rates) at all s
+/// stages at once (passive_rates_stages, passive_coupling_rates_stages), bit for bit the same as
+/// stage by stage: the passive quadrature's sweeps (passive_quadrature.h).
+template <class System, int Stages>
+constexpr bool kHasPassiveStageRates = detail::HasPassiveStageRates<System, Stages>::value;
 
 /// The angles the system declares (kAngleCoordinates), in its order; none by default.
 template <class System>

@@ -27,6 +27,7 @@
 #include <cmath>
 #include <cstddef>
 #include <type_traits>
+#include <utility>
 
 #include "birkhoff_cart/core/integrators/autodiff.h"
 #include "birkhoff_cart/core/integrators/birkhoffian_system.h"
@@ -75,6 +76,21 @@ class TimeTransformedSystem {
     return sqrt(base * base + S(stiff_density_squared_));
   }
 
+  /// σ at the stages z[j] (step_density stage by stage, bit for bit), in one call where the system
+  /// batches its own (step_density_stages: one vector call for the stages' sin χ on the cart).
+  template <std::size_t Count>
+  void step_density_stages(const std::array<Vector<double>, Count>& z, std::array<double, Count>& densities) const {
+    if constexpr (kSystemHasStepDensityStages<Count>) {
+      using std::sqrt;
+      system_->step_density_stages(z, densities);
+      if (stiff_density_squared_ != 0.0) {
+        for (std::size_t j = 0; j < Count; ++j) densities[j] = sqrt(densities[j] * densities[j] + stiff_density_squared_);
+      }
+    } else {
+      for (std::size_t j = 0; j < Count; ++j) densities[j] = step_density(z[j]);
+    }
+  }
+
   template <class S>
   Vector<S> to_darboux(const Vector<S>& z, const S& /*tau*/) const {
     return z;
@@ -91,6 +107,20 @@ class TimeTransformedSystem {
     return system_->darboux_rates(w, t) / step_density(w);
   }
 
+  /// dw/dτ and (g/σ, 1/σ) at one point from one σ and the base system's shared evaluation, where it
+  /// has one (bit for bit darboux_rates and passive_rates).
+  template <class Base = System, class = std::enable_if_t<system_traits::kHasDarbouxAndPassiveRates<Base>>>
+  void darboux_and_passive_rates(const Vector<double>& w, const Passive<double>& y, double /*tau*/,
+                                 Vector<double>& rate, Passive<double>& passive) const {
+    Vector<double> base_rate;
+    BasePassive<double> base_passive;
+    system_->darboux_and_passive_rates(w, BasePassive<double>(y.template head<System::kPassiveDimension>()), load_time_,
+                                       base_rate, base_passive);
+    const double density = step_density(w);
+    rate = base_rate / density;
+    passive = in_fictive_time(base_passive, 1.0 / density);
+  }
+
   /// The stages' dw/dτ in one call where the system batches its stage rates.
   template <std::size_t Count, class Base = System,
             class = std::enable_if_t<system_traits::kHasStageRates<Base, static_cast<int>(Count)>>>
@@ -99,7 +129,9 @@ class TimeTransformedSystem {
     std::array<double, Count> times;
     times.fill(load_time_);
     system_->darboux_rates_stages(w, times, rates);
-    for (std::size_t j = 0; j < Count; ++j) rates[j] /= step_density(w[j]);
+    std::array<double, Count> densities;
+    step_density_stages(w, densities);
+    for (std::size_t j = 0; j < Count; ++j) rates[j] /= densities[j];
   }
 
   /// J_τ = ∂(ẇ/σ)/∂w = J/σ − ẇ (∇σ)ᵀ/σ².
@@ -122,27 +154,70 @@ class TimeTransformedSystem {
   template <class S>
   Passive<S> passive_rates(const Vector<S>& z, const Passive<S>& y, const S& /*tau*/) const {
     const S t(load_time_);
-    const S inverse_density = S(1.0) / step_density(z);
-    Passive<S> rate;
-    rate.template head<System::kPassiveDimension>() =
-        passive_coordinate_rates(*system_, z, BasePassive<S>(y.template head<System::kPassiveDimension>()), t) *
-        inverse_density;
-    rate(kTimeIndex) = inverse_density;
-    return rate;
+    return in_fictive_time(
+        passive_coordinate_rates(*system_, z, BasePassive<S>(y.template head<System::kPassiveDimension>()), t),
+        S(S(1.0) / step_density(z)));
+  }
+
+  /// passive_rates at the stages in one call where the base system batches its own (bit for bit
+  /// passive_rates stage by stage).
+  template <std::size_t Count, class Base = System,
+            class = std::enable_if_t<system_traits::kHasPassiveStageRates<Base, static_cast<int>(Count)>>>
+  void passive_rates_stages(const std::array<Vector<double>, Count>& z, const std::array<Passive<double>, Count>& y,
+                            const std::array<double, Count>& /*tau*/, std::array<Passive<double>, Count>& rates) const {
+    std::array<BasePassive<double>, Count> base_y;
+    std::array<BasePassive<double>, Count> base_rates;
+    std::array<double, Count> times;
+    times.fill(load_time_);
+    for (std::size_t j = 0; j < Count; ++j) base_y[j] = y[j].template head<System::kPassiveDimension>();
+    system_->passive_rates_stages(z, base_y, times, base_rates);
+    std::array<double, Count> densities;
+    step_density_stages(z, densities);
+    for (std::size_t j = 0; j < Count; ++j) rates[j] = in_fictive_time(base_rates[j], 1.0 / densities[j]);
+  }
+
+  /// passive_coupling_rates at the stages in one call (as passive_rates_stages).
+  template <std::size_t Count, class Base = System,
+            class = std::enable_if_t<system_traits::kHasPassiveStageRates<Base, static_cast<int>(Count)>>>
+  void passive_coupling_rates_stages(const std::array<Vector<double>, Count>& z, const std::array<double, Count>& /*tau*/,
+                                     std::array<Passive<double>, Count>& rates) const {
+    std::array<BasePassive<double>, Count> base_rates;
+    std::array<double, Count> times;
+    times.fill(load_time_);
+    system_->passive_coupling_rates_stages(z, times, base_rates);
+    std::array<double, Count> densities;
+    step_density_stages(z, densities);
+    for (std::size_t j = 0; j < Count; ++j) rates[j] = in_fictive_time(base_rates[j], 1.0 / densities[j]);
   }
 
   /// The passive rates g reads, alone (1/σ and the base system's, scaled).
   template <class S, class Base = System, class = std::enable_if_t<system_traits::kHasPassiveCouplingRates<Base>>>
   Passive<S> passive_coupling_rates(const Vector<S>& z, const S& /*tau*/) const {
     const S t(load_time_);
-    const S inverse_density = S(1.0) / step_density(z);
+    return in_fictive_time(BasePassive<S>(system_->passive_coupling_rates(z, t)), S(S(1.0) / step_density(z)));
+  }
+
+ private:
+  /// (g/σ, 1/σ) from g and 1/σ [s]: the passive rates in fictive time, time last (every passive
+  /// rate above goes through here).
+  template <class S>
+  static Passive<S> in_fictive_time(const BasePassive<S>& rates, const S& inverse_density) {
     Passive<S> rate;
-    rate.template head<System::kPassiveDimension>() = system_->passive_coupling_rates(z, t) * inverse_density;
+    rate.template head<System::kPassiveDimension>() = rates * inverse_density;
     rate(kTimeIndex) = inverse_density;
     return rate;
   }
 
- private:
+  template <std::size_t Count, class = void>
+  struct SystemStepDensityStages : std::false_type {};
+  template <std::size_t Count>
+  struct SystemStepDensityStages<Count, std::void_t<decltype(std::declval<const System&>().step_density_stages(
+                                            std::declval<const std::array<Vector<double>, Count>&>(),
+                                            std::declval<std::array<double, Count>&>()))>> : std::true_type {};
+  /// The system gives σ at Count stages in one call.
+  template <std::size_t Count>
+  static constexpr bool kSystemHasStepDensityStages = SystemStepDensityStages<Count>::value;
+
   const System* system_;
   double load_time_;               ///< [s]
   double stiff_density_squared_;   ///< [1/s²]

@@ -170,11 +170,23 @@ class CartBirkhoffianBase {
   template <class S>
   S step_density(const Vector<S>& z) const {
     using deterministic::sin;
+    return step_density_at(S(sin(z(kSteeringAngleIndex))), z);
+  }
+  /// The same from s = sin χ.
+  template <class S>
+  S step_density_at(const S& s, const Vector<S>& z) const {
     using std::sqrt;
     constexpr double kDensityFloor = 1.0;  // σ₀ [1/s]
-    const Vector2<S> omega = quasi_velocity(z);
-    const S heading_rate = omega(0) * sin(z(kSteeringAngleIndex)) / model_->parameters().wheelbase;
+    const Vector2<S> omega = quasi_velocity_at(s, z);
+    const S heading_rate = omega(0) * s / model_->parameters().wheelbase;
     return sqrt(omega(1) * omega(1) + heading_rate * heading_rate + S(kDensityFloor * kDensityFloor));
+  }
+  /// σ at the s stages of a collocation step, sin χ from one sin_cos_lanes call (vector_math.h); bit
+  /// for bit step_density stage by stage (the reversible control divides every stage's rates by it).
+  template <std::size_t Count>
+  void step_density_stages(const std::array<Vector<double>, Count>& z, std::array<double, Count>& densities) const {
+    const StageSteeringTrig<Count> steering = stage_steering_trig(z);
+    for (std::size_t j = 0; j < Count; ++j) densities[j] = step_density_at(steering.sines[j], z[j]);
   }
 
   /// H̃ = ½ pᵀ M(χ)⁻¹ p = T* [J].
@@ -223,7 +235,66 @@ class CartBirkhoffianBase {
     const Vector2<S> omega = quasi_velocity_at(trig.s, z);
     const CoordinateRates<S> rates =
         model_->coordinate_rates_at(y(kHeadingIndex), z(kSteeringAngleIndex), trig.s, trig.c, omega);
-    const Vector2<S> force = generalized_force(z(kSteeringAngleIndex), omega, t);
+    return passive_rates_from(omega, rates, generalized_force(z(kSteeringAngleIndex), omega, t));
+  }
+
+  /// The stages' steering angles χ [rad] with their sines and cosines [-], from one sin_cos_lanes call
+  /// (vector_math.h): the same bits as deterministic::sin and cos angle by angle.
+  template <std::size_t Count>
+  struct StageSteeringTrig {
+    std::array<double, Count> angles;
+    std::array<double, Count> sines;
+    std::array<double, Count> cosines;
+  };
+  template <std::size_t Count>
+  static StageSteeringTrig<Count> stage_steering_trig(const std::array<Vector<double>, Count>& z) {
+    static_assert(Count <= kMaxVectorLanes, "one vector call takes at most kMaxVectorLanes angles");
+    StageSteeringTrig<Count> trig;
+    for (std::size_t j = 0; j < Count; ++j) trig.angles[j] = z[j](kSteeringAngleIndex);
+    sin_cos_lanes(trig.angles.data(), static_cast<int>(Count), trig.sines.data(), trig.cosines.data());
+    return trig;
+  }
+
+  /// g at the s stages of a collocation step (passive_quadrature.h): the sines and cosines of the
+  /// steering angles and of the front axle's headings θ + χ from one sin_cos_lanes call each
+  /// (vector_math.h), the rest as passive_rates; bit for bit passive_rates stage by stage.
+  template <std::size_t Count>
+  void passive_rates_stages(const std::array<Vector<double>, Count>& z, const std::array<Passive<double>, Count>& y,
+                            const std::array<double, Count>& t, std::array<Passive<double>, Count>& rates) const {
+    const StageSteeringTrig<Count> steering = stage_steering_trig(z);
+    double front_headings[Count];
+    double front_sines[Count];
+    double front_cosines[Count];
+    for (std::size_t j = 0; j < Count; ++j) {
+      front_headings[j] = y[j](kHeadingIndex) + steering.angles[j];  // θ + χ, as coordinate_rates_at forms it
+    }
+    sin_cos_lanes(front_headings, static_cast<int>(Count), front_sines, front_cosines);
+    for (std::size_t j = 0; j < Count; ++j) {
+      const Vector2<double> omega = quasi_velocity_at(steering.sines[j], z[j]);
+      const CoordinateRates<double> coordinate_rates = model_->coordinate_rates_from(
+          steering.sines[j], steering.cosines[j], front_sines[j], front_cosines[j], omega);
+      rates[j] = passive_rates_from(omega, coordinate_rates, generalized_force(steering.angles[j], omega, t[j]));
+    }
+  }
+
+  /// passive_coupling_rates at the s stages, sin χ from one sin_cos_lanes call; bit for bit
+  /// passive_coupling_rates stage by stage.
+  template <std::size_t Count>
+  void passive_coupling_rates_stages(const std::array<Vector<double>, Count>& z, const std::array<double, Count>& /*t*/,
+                                     std::array<Passive<double>, Count>& rates) const {
+    const StageSteeringTrig<Count> steering = stage_steering_trig(z);
+    for (std::size_t j = 0; j < Count; ++j) {
+      rates[j] = Passive<double>::Constant(cart_birkhoffian_zero(steering.angles[j]));
+      rates[j](kHeadingIndex) = model_->heading_rate_at(steering.sines[j], quasi_velocity_at(steering.sines[j], z[j]));
+    }
+  }
+
+ protected:
+  /// g from ω = M⁻¹p, the coordinate rates and the loads Q = (Q1 [N], Q2 [N·m]) at (z, t): the
+  /// work rate ω·Q [W] and the impulse rate Q2.
+  template <class S>
+  Passive<S> passive_rates_from(const Vector2<S>& omega, const CoordinateRates<S>& rates,
+                                const Vector2<S>& force) const {
     Passive<S> rate;
     rate(kXIndex) = rates.x_rate;
     rate(kYIndex) = rates.y_rate;
@@ -363,6 +434,30 @@ class CartAutonomousBirkhoffian : public CartBirkhoffianBase, public CartStageRa
       rate(kSteeringMomentumIndex) = model_->kinetic_energy_steering_derivative_at(trig.s, trig.c, omega);
     }
     return rate;
+  }
+
+  /// ẇ and g at one point (w = z: the identity chart), from one sin χ and cos χ, one ω = M⁻¹p and
+  /// one evaluation of the loads, which darboux_rates and passive_rates would each compute: the
+  /// local error estimate's rates at a step's end (collocation_error_estimate.h). Bit for bit the
+  /// two of them.
+  void darboux_and_passive_rates(const Vector<double>& w, const Passive<double>& y, double t, Vector<double>& rate,
+                                 Passive<double>& passive) const {
+    const double chi = w(kSteeringAngleIndex);
+    const SteeringTrig<double> trig = steering_trig(chi);
+    const Vector2<double> omega = quasi_velocity_at(trig.s, w);
+    const Vector2<double> force = generalized_force(chi, omega, t);  // zero when the force is disabled
+    // ẇ as darboux_rates_at writes it (which stays as it is: the stage solve's hot path, inlined).
+    rate(kArcLengthIndex) = omega(0);
+    rate(kSteeringAngleIndex) = omega(1);
+    if (non_birkhoffian_force_enabled_) {
+      const Vector2<double> p_rate = model_->momentum_rate_at(trig.s, trig.c, omega, force);
+      rate(kForwardMomentumIndex) = p_rate(0);
+      rate(kSteeringMomentumIndex) = p_rate(1);
+    } else {
+      rate(kForwardMomentumIndex) = cart_birkhoffian_detail::zero_like(omega(0));
+      rate(kSteeringMomentumIndex) = model_->kinetic_energy_steering_derivative_at(trig.s, trig.c, omega);
+    }
+    passive = passive_rates_from(omega, model_->coordinate_rates_at(y(kHeadingIndex), chi, trig.s, trig.c, omega), force);
   }
 
   /// J = ∂ẇ/∂w [rows: rates of (π1, χ, p1, p2); columns: (π1, χ, p1, p2)] in closed form, for the

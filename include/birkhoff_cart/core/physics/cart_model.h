@@ -189,10 +189,16 @@ class CartModel {
                                               const Scalar& c, const Vector2<Scalar>& quasi_velocity) const {
     using deterministic::cos;
     using deterministic::sin;
-    CoordinateRates<Scalar> rates;
     const Scalar front_heading = heading + steering_angle;
-    rates.x_rate = quasi_velocity(0) * cos(front_heading);
-    rates.y_rate = quasi_velocity(0) * sin(front_heading);
+    return coordinate_rates_from(s, c, Scalar(sin(front_heading)), Scalar(cos(front_heading)), quasi_velocity);
+  }
+  /// The same from s = sin χ, c = cos χ and the sine and cosine of the front axle's heading θ + χ.
+  template <class Scalar>
+  CoordinateRates<Scalar> coordinate_rates_from(const Scalar& s, const Scalar& c, const Scalar& front_sin,
+                                                const Scalar& front_cos, const Vector2<Scalar>& quasi_velocity) const {
+    CoordinateRates<Scalar> rates;
+    rates.x_rate = quasi_velocity(0) * front_cos;
+    rates.y_rate = quasi_velocity(0) * front_sin;
     rates.heading_rate = heading_rate_at(s, quasi_velocity);
     std::array<Scalar, 4> d1;
     std::array<double, 4> d2;

@@ -106,11 +106,19 @@ class EffectSet {
   /// the analytic Jacobian for AD scalars (t is never differentiated).
   template <class S>
   Vector2<S> generalized_force(double time, const S& steering_angle, const Vector2<S>& quasi_velocity) const {
-    Vector2<S> result;
-    if (effects_.empty() && !end_stops_) {
-      result.setConstant(S(0.0) * steering_angle);
-      return result;
+    if (effects_.empty() && !end_stops_) {  // small, so that every right-hand side inlines it
+      Vector2<S> none;
+      none.setConstant(S(0.0) * steering_angle);
+      return none;
     }
+    return generalized_force_of_loads(time, steering_angle, quasi_velocity);
+  }
+
+ private:
+  /// generalized_force where an effect or the end stops are enabled.
+  template <class S>
+  Vector2<S> generalized_force_of_loads(double time, const S& steering_angle, const Vector2<S>& quasi_velocity) const {
+    Vector2<S> result;
     const GeneralizedForce total = force_and_jacobian(
         time, value_of(steering_angle), Vector2<double>(value_of(quasi_velocity(0)), value_of(quasi_velocity(1))));
     const S inputs[3] = {steering_angle, quasi_velocity(0), quasi_velocity(1)};
@@ -120,6 +128,8 @@ class EffectSet {
     }
     return result;
   }
+
+ public:
 
   /// The command inputs of effects whose source is `command` (nullptr when none).
   std::shared_ptr<CommandInput> steering_command() const { return steering_command_; }
