@@ -139,27 +139,6 @@ class CartBirkhoffianBase {
     return model_->quasi_velocity(chi, Vector2<S>(p_rate - mass_rate_omega));
   }
 
-  /// The squared step density of the reversible step control (reversible_step_control.h,
-  /// docs/birkhoffian.md §11, eq. (B.44)) [1/s²]:
-  ///   σ² = ω2² + θ̇² + √((ω̇1/l)² + ω̇2² + σ₀⁴),   θ̇ = ω1 sin χ / l (eq. (2.3)),
-  /// how fast the front axle turns against the body and the body against the ground, and how fast
-  /// those rates change (a hinge spring's swing, a torque's push). On the jackknife whirl χ turns at
-  /// up to 5 rad/s near the jackknife and at 0.8 rad/s elsewhere: the steps shrink there. σ₀
-  /// [1/s] is the slowest rate the steps resolve where the cart neither turns nor accelerates.
-  template <class S>
-  S squared_step_density(const Vector<S>& z, const S& t, double density_floor) const {
-    using deterministic::sin;
-    using std::sqrt;
-    const double l = model_->parameters().wheelbase;
-    const Vector2<S> omega = quasi_velocity(z);
-    const Vector2<S> acceleration = quasi_acceleration(z, t);
-    const S heading_rate = omega(0) * sin(z(kSteeringAngleIndex)) / l;
-    const S forward = acceleration(0) / l;
-    const double floor4 = density_floor * density_floor * density_floor * density_floor;
-    return omega(1) * omega(1) + heading_rate * heading_rate +
-           sqrt(forward * forward + acceleration(1) * acceleration(1) + S(floor4));
-  }
-
   /// The step density of the reversible step control's time transformation
   /// (time_transformed_system.h, docs/birkhoffian.md §11.2, eq. (B.44)) [1/s]:
   ///   σ = √(ω2² + θ̇² + σ₀²),   θ̇ = ω1 sin χ / l (eq. (2.3)),   σ₀ = 1 s⁻¹,
