@@ -58,16 +58,17 @@ void passive_quadrature(const System& system, const GaussLegendreTableau& tablea
           system.passive_rates_stages(stage_points, passive_stages, stage_times, passive_rates);
           statistics.passive_evaluations += Stages;
         }
-      }
-      for (int j = 0; j < Stages && !kStagesTogether; ++j) {
-        if constexpr (kCouplingSweeps) {
-          if (sweep < kDepth) {
-            passive_rates[j] = system.passive_coupling_rates(stage_points[j], S(stage_times[j]));
-            continue;
+      } else {
+        for (int j = 0; j < Stages; ++j) {
+          if constexpr (kCouplingSweeps) {
+            if (sweep < kDepth) {
+              passive_rates[j] = system.passive_coupling_rates(stage_points[j], S(stage_times[j]));
+              continue;
+            }
           }
+          passive_rates[j] = passive_coordinate_rates(system, stage_points[j], passive_stages[j], S(stage_times[j]));
+          ++statistics.passive_evaluations;
         }
-        passive_rates[j] = passive_coordinate_rates(system, stage_points[j], passive_stages[j], S(stage_times[j]));
-        ++statistics.passive_evaluations;
       }
       if (kDepth >= 0 && sweep == kDepth) break;  // exact: the rates just computed are final
       double change = 0.0;

@@ -70,10 +70,8 @@ class TimeTransformedSystem {
   /// σ(z) = √(σ_system(z)² + σ_stiff²) [1/s] (eq. (B.44)).
   template <class S>
   S step_density(const Vector<S>& z) const {
-    using std::sqrt;
     if (stiff_density_squared_ == 0.0) return system_traits::step_density(*system_, z);
-    const S base = system_traits::step_density(*system_, z);
-    return sqrt(base * base + S(stiff_density_squared_));
+    return with_stiff_density(system_traits::step_density(*system_, z));
   }
 
   /// σ at the stages z[j] (step_density stage by stage, bit for bit), in one call where the system
@@ -81,10 +79,9 @@ class TimeTransformedSystem {
   template <std::size_t Count>
   void step_density_stages(const std::array<Vector<double>, Count>& z, std::array<double, Count>& densities) const {
     if constexpr (kSystemHasStepDensityStages<Count>) {
-      using std::sqrt;
       system_->step_density_stages(z, densities);
       if (stiff_density_squared_ != 0.0) {
-        for (std::size_t j = 0; j < Count; ++j) densities[j] = sqrt(densities[j] * densities[j] + stiff_density_squared_);
+        for (std::size_t j = 0; j < Count; ++j) densities[j] = with_stiff_density(densities[j]);
       }
     } else {
       for (std::size_t j = 0; j < Count; ++j) densities[j] = step_density(z[j]);
@@ -198,6 +195,13 @@ class TimeTransformedSystem {
   }
 
  private:
+  /// √(σ_system² + σ_stiff²) [1/s] from σ_system (eq. (B.44)).
+  template <class S>
+  S with_stiff_density(const S& base) const {
+    using std::sqrt;
+    return sqrt(base * base + S(stiff_density_squared_));
+  }
+
   /// (g/σ, 1/σ) from g and 1/σ [s]: the passive rates in fictive time, time last (every passive
   /// rate above goes through here).
   template <class S>

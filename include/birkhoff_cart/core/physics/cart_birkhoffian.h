@@ -316,14 +316,10 @@ class CartStageRates {
   template <std::size_t Count>
   void darboux_rates_stages(const std::array<Vector<double>, Count>& w, const std::array<double, Count>& t,
                             std::array<Vector<double>, Count>& rates) const {
-    static_assert(Count <= kMaxVectorLanes, "one vector call takes at most kMaxVectorLanes angles");
-    double angles[Count];
-    double sines[Count];
-    double cosines[Count];
-    for (std::size_t j = 0; j < Count; ++j) angles[j] = w[j](kSteeringAngleIndex);
-    sin_cos_lanes(angles, static_cast<int>(Count), sines, cosines);
+    const auto steering = CartBirkhoffianBase::stage_steering_trig(w);
     for (std::size_t j = 0; j < Count; ++j) {
-      rates[j] = form().darboux_rates_at(w[j], t[j], CartBirkhoffianBase::SteeringTrig<double>{sines[j], cosines[j]});
+      rates[j] = form().darboux_rates_at(
+          w[j], t[j], CartBirkhoffianBase::SteeringTrig<double>{steering.sines[j], steering.cosines[j]});
     }
   }
 
