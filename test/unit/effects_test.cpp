@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -14,6 +16,7 @@
 #include "birkhoff_cart/core/physics/cart_model.h"
 #include "birkhoff_cart/core/physics/effect_library.h"
 #include "birkhoff_cart/core/physics/effects.h"
+#include "birkhoff_cart/core/integrators/deterministic_math.h"
 #include "birkhoff_cart/core/physics/effects/air_drag.h"
 #include "birkhoff_cart/core/physics/effects/drive_torque.h"
 #include "birkhoff_cart/core/physics/effects/rolling_resistance.h"
@@ -389,6 +392,38 @@ TEST(EffectSet, SumIsTheSumOfTheSingleEffects) {
     const GeneralizedForce total = all.evaluate(input);
     EXPECT_TRUE(total.force.isApprox(summed.force, 1e-14));
     EXPECT_TRUE(total.jacobian.isApprox(summed.jacobian, 1e-14));
+  }
+}
+
+TEST(EffectSet, TheCallersSinAndCosOfTheSteeringAngleGiveTheSameLoadsBitForBit) {
+  // The right-hand sides pass sin χ and cos χ they have already computed (EffectInput: one vector
+  // call for the stages); the loads must be those the effects compute themselves, bit for bit, or
+  // a trajectory would depend on which path evaluated it. 4000 random states, every effect; and a
+  // given value is used (a wrong one moves the loads), so the shortcut is not a dead branch.
+  const CartModel model{CartParameters{}};
+  const EffectSet all = build_effects(birkhoff_cart_test::all_effect_specs(), model);
+  std::mt19937_64 random(20261130);
+  std::uniform_real_distribution<double> angle(-7.0, 7.0), speed(-8.0, 8.0), rate(-3.0, 3.0), time(0.0, 30.0);
+  for (int sample = 0; sample < 4000; ++sample) {
+    EffectInput plain = make_input(time(random), angle(random), speed(random), rate(random));
+    if (sample % 5 == 0) plain.forward_speed *= 1e-3;  // inside the rolling resistance's tanh band
+    EffectInput given = plain;
+    given.steering_sin = deterministic::sin(plain.steering_angle);
+    given.steering_cos = deterministic::cos(plain.steering_angle);
+    const GeneralizedForce computed = all.evaluate(plain);
+    const GeneralizedForce shared = all.evaluate(given);
+    for (int row = 0; row < 2; ++row) {
+      ASSERT_EQ(std::memcmp(&computed.force(row), &shared.force(row), sizeof(double)), 0) << "Q" << row + 1 << " at sample " << sample;
+      for (int column = 0; column < 3; ++column) {
+        ASSERT_EQ(std::memcmp(&computed.jacobian(row, column), &shared.jacobian(row, column), sizeof(double)), 0)
+            << "dQ" << row + 1 << " column " << column << " at sample " << sample;
+      }
+    }
+    if (sample == 0) {
+      EffectInput wrong = given;
+      wrong.steering_cos = -given.steering_cos;
+      EXPECT_NE(all.evaluate(wrong).force(0), computed.force(0)) << "the given cos chi is read";
+    }
   }
 }
 

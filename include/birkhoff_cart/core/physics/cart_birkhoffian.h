@@ -115,9 +115,15 @@ class CartBirkhoffianBase {
   /// Q = (Q1 [N], Q2 [N·m]) of the enabled loads at χ [rad] and ω = M(χ)⁻¹ p [m/s, rad/s] (the
   /// caller's, so that one evaluation of the right-hand side solves M ω = p once); zero when the
   /// non-Birkhoffian force is disabled.
+  /// `trig`: sin χ and cos χ where the caller has computed them (double only), so that the loads do
+  /// not compute them again (EffectInput; the same bits).
   template <class S>
-  Vector2<S> generalized_force(const S& steering_angle, const Vector2<S>& omega, const S& t) const {
+  Vector2<S> generalized_force(const S& steering_angle, const Vector2<S>& omega, const S& t,
+                               const SteeringTrig<S>* trig = nullptr) const {
     if (!non_birkhoffian_force_enabled_) return Vector2<S>(S(0.0) * omega(0), S(0.0) * omega(0));
+    if constexpr (std::is_same_v<S, double>) {
+      if (trig != nullptr) return effects_->generalized_force(t, steering_angle, omega, trig->s, trig->c);
+    }
     return effects_->generalized_force(value_of(t), steering_angle, omega);
   }
 
@@ -214,7 +220,7 @@ class CartBirkhoffianBase {
     const Vector2<S> omega = quasi_velocity_at(trig.s, z);
     const CoordinateRates<S> rates =
         model_->coordinate_rates_at(y(kHeadingIndex), z(kSteeringAngleIndex), trig.s, trig.c, omega);
-    return passive_rates_from(omega, rates, generalized_force(z(kSteeringAngleIndex), omega, t));
+    return passive_rates_from(omega, rates, generalized_force(z(kSteeringAngleIndex), omega, t, &trig));
   }
 
   /// The stages' steering angles χ [rad] with their sines and cosines [-], from one sin_cos_lanes call
@@ -252,7 +258,8 @@ class CartBirkhoffianBase {
       const Vector2<double> omega = quasi_velocity_at(steering.sines[j], z[j]);
       const CoordinateRates<double> coordinate_rates = model_->coordinate_rates_from(
           steering.sines[j], steering.cosines[j], front_sines[j], front_cosines[j], omega);
-      rates[j] = passive_rates_from(omega, coordinate_rates, generalized_force(steering.angles[j], omega, t[j]));
+      const SteeringTrig<double> trig{steering.sines[j], steering.cosines[j]};
+      rates[j] = passive_rates_from(omega, coordinate_rates, generalized_force(steering.angles[j], omega, t[j], &trig));
     }
   }
 
@@ -401,7 +408,7 @@ class CartAutonomousBirkhoffian : public CartBirkhoffianBase, public CartStageRa
     rate(kArcLengthIndex) = omega(0);
     rate(kSteeringAngleIndex) = omega(1);
     if (non_birkhoffian_force_enabled_) {
-      const Vector2<S> p_rate = model_->momentum_rate_at(trig.s, trig.c, omega, generalized_force(chi, omega, t));
+      const Vector2<S> p_rate = model_->momentum_rate_at(trig.s, trig.c, omega, generalized_force(chi, omega, t, &trig));
       rate(kForwardMomentumIndex) = p_rate(0);
       rate(kSteeringMomentumIndex) = p_rate(1);
     } else {
@@ -420,7 +427,7 @@ class CartAutonomousBirkhoffian : public CartBirkhoffianBase, public CartStageRa
     const double chi = w(kSteeringAngleIndex);
     const SteeringTrig<double> trig = steering_trig(chi);
     const Vector2<double> omega = quasi_velocity_at(trig.s, w);
-    const Vector2<double> force = generalized_force(chi, omega, t);  // zero when the force is disabled
+    const Vector2<double> force = generalized_force(chi, omega, t, &trig);  // zero when the force is disabled
     // ẇ as darboux_rates_at writes it (which stays as it is: the stage solve's hot path, inlined).
     rate(kArcLengthIndex) = omega(0);
     rate(kSteeringAngleIndex) = omega(1);
@@ -466,7 +473,7 @@ class CartAutonomousBirkhoffian : public CartBirkhoffianBase, public CartStageRa
     const double w1 = omega(0);
     const double w2 = omega(1);
     if (non_birkhoffian_force_enabled_) {
-      const GeneralizedForce load = effects_->force_and_jacobian(t, chi, omega);
+      const GeneralizedForce load = effects_->force_and_jacobian(t, chi, omega, s, c);
       p_rate_chi << inertia.mu1 * (c * c - s * s) * w1 * w2 - inertia.nu * s * w2 * w2 + load.jacobian(0, 0),
           load.jacobian(1, 0);
       p_rate_omega << inertia.mu1 * s * c * w2 + load.jacobian(0, 1),
@@ -579,7 +586,7 @@ class CartPaperBirkhoffian : public CartBirkhoffianBase, public CartStageRates<C
     rate(kArcLengthIndex) = omega(0);
     rate(kSteeringAngleIndex) = omega(1);
     if (non_birkhoffian_force_enabled_) {
-      const Vector2<S> p_rate = model_->momentum_rate_at(trig.s, trig.c, omega, generalized_force(chi, omega, t));
+      const Vector2<S> p_rate = model_->momentum_rate_at(trig.s, trig.c, omega, generalized_force(chi, omega, t, &trig));
       rate(kForwardMomentumIndex) = e * (p_rate(0) + z(kForwardMomentumIndex));
       rate(kSteeringMomentumIndex) = e * (p_rate(1) + z(kSteeringMomentumIndex));
     } else {

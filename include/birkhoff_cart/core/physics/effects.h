@@ -5,12 +5,14 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "birkhoff_cart/core/integrators/autodiff.h"
+#include "birkhoff_cart/core/integrators/deterministic_math.h"
 #include "birkhoff_cart/core/physics/cart_model.h"
 
 namespace birkhoff_cart {
@@ -24,6 +26,14 @@ struct EffectInput {
   double steering_angle = 0.0;  ///< χ [rad]
   double forward_speed = 0.0;   ///< ω1 [m/s]
   double steering_rate = 0.0;   ///< ω2 [rad/s]
+  /// sin χ and cos χ [-] where the caller already has them (the right-hand side computes them once
+  /// per evaluation; for the stages, in one vector call): deterministic::sin and cos of χ bit for
+  /// bit, so the loads are the same with or without them. NaN: not given, the effects compute them.
+  double steering_sin = std::numeric_limits<double>::quiet_NaN();
+  double steering_cos = std::numeric_limits<double>::quiet_NaN();
+
+  double sin_steering_angle() const { return std::isnan(steering_sin) ? deterministic::sin(steering_angle) : steering_sin; }
+  double cos_steering_angle() const { return std::isnan(steering_cos) ? deterministic::cos(steering_angle) : steering_cos; }
 };
 
 /// Generalized force and its analytic Jacobian (used by Newton's method and by AD).
@@ -92,35 +102,45 @@ class EffectSet {
 
   /// Q with its Jacobian ∂Q/∂(χ, ω1, ω2) at a point (zero when no effect and no end stop acts): for
   /// analytic Jacobians of the rates (cart_birkhoffian.h darboux_jacobian).
-  GeneralizedForce force_and_jacobian(double time, double steering_angle, const Vector2<double>& quasi_velocity) const {
+  /// `steering_sin`, `steering_cos`: sin χ and cos χ where the caller has them (EffectInput), else NaN.
+  GeneralizedForce force_and_jacobian(double time, double steering_angle, const Vector2<double>& quasi_velocity,
+                                      double steering_sin = std::numeric_limits<double>::quiet_NaN(),
+                                      double steering_cos = std::numeric_limits<double>::quiet_NaN()) const {
     if (effects_.empty() && !end_stops_) return GeneralizedForce{};
     EffectInput input;
     input.time = time;
     input.steering_angle = steering_angle;
     input.forward_speed = quasi_velocity(0);
     input.steering_rate = quasi_velocity(1);
+    input.steering_sin = steering_sin;
+    input.steering_cos = steering_cos;
     return evaluate(input);
   }
 
   /// Q as scalars of type S: plain values for double, values with derivatives propagated through
   /// the analytic Jacobian for AD scalars (t is never differentiated).
+  /// `steering_sin`, `steering_cos`: as force_and_jacobian's.
   template <class S>
-  Vector2<S> generalized_force(double time, const S& steering_angle, const Vector2<S>& quasi_velocity) const {
+  Vector2<S> generalized_force(double time, const S& steering_angle, const Vector2<S>& quasi_velocity,
+                               double steering_sin = std::numeric_limits<double>::quiet_NaN(),
+                               double steering_cos = std::numeric_limits<double>::quiet_NaN()) const {
     if (effects_.empty() && !end_stops_) {  // small, so that every right-hand side inlines it
       Vector2<S> none;
       none.setConstant(S(0.0) * steering_angle);
       return none;
     }
-    return generalized_force_of_loads(time, steering_angle, quasi_velocity);
+    return generalized_force_of_loads(time, steering_angle, quasi_velocity, steering_sin, steering_cos);
   }
 
  private:
   /// generalized_force where an effect or the end stops are enabled.
   template <class S>
-  Vector2<S> generalized_force_of_loads(double time, const S& steering_angle, const Vector2<S>& quasi_velocity) const {
+  Vector2<S> generalized_force_of_loads(double time, const S& steering_angle, const Vector2<S>& quasi_velocity,
+                                        double steering_sin, double steering_cos) const {
     Vector2<S> result;
-    const GeneralizedForce total = force_and_jacobian(
-        time, value_of(steering_angle), Vector2<double>(value_of(quasi_velocity(0)), value_of(quasi_velocity(1))));
+    const GeneralizedForce total =
+        force_and_jacobian(time, value_of(steering_angle), Vector2<double>(value_of(quasi_velocity(0)), value_of(quasi_velocity(1))),
+                           steering_sin, steering_cos);
     const S inputs[3] = {steering_angle, quasi_velocity(0), quasi_velocity(1)};
     for (int row = 0; row < 2; ++row) {
       const double partials[3] = {total.jacobian(row, 0), total.jacobian(row, 1), total.jacobian(row, 2)};

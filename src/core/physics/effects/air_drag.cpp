@@ -14,8 +14,8 @@ const std::string& AirDrag::name() const {
 }
 
 void AirDrag::add_to(const EffectInput& input, GeneralizedForce& total) const {
-  const double s = deterministic::sin(input.steering_angle);
-  const double c = deterministic::cos(input.steering_angle);
+  const double s = input.sin_steering_angle();
+  const double c = input.cos_steering_angle();
   const double speed_a = input.forward_speed * c;  // v_A = ω1 cos χ [m/s]   (eq. (2.3))
   const double k = coefficient_;
   // Q1 += −k |v_A| v_A cos χ   (eq. (4.4))

@@ -24,8 +24,8 @@ void DriveTorque::add_to(const EffectInput& input, GeneralizedForce& total) cons
   // total torque T does power T ω1 cos χ / r1:  Q1 += T cos χ / r1   (eq. (4.2)).
   const double torque = source_.at(input.time);  // T [N·m]
   const double per_radius = torque / rear_wheel_radius_;  // [N]
-  total.force(0) += per_radius * deterministic::cos(input.steering_angle);
-  total.jacobian(0, 0) += -per_radius * deterministic::sin(input.steering_angle);  // ∂Q1/∂χ
+  total.force(0) += per_radius * input.cos_steering_angle();
+  total.jacobian(0, 0) += -per_radius * input.sin_steering_angle();  // ∂Q1/∂χ
 }
 
 }  // namespace birkhoff_cart

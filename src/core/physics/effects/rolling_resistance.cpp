@@ -21,15 +21,14 @@ const std::string& RollingResistance::name() const {
 }
 
 void RollingResistance::add_to(const EffectInput& input, GeneralizedForce& total) const {
-  const double chi = input.steering_angle;
   const double w1 = input.forward_speed;
   const double w2 = input.steering_rate;
+  const double s = input.sin_steering_angle();
+  const double c = input.cos_steering_angle();
   std::array<double, 4> d1;
   std::array<double, 4> d2;
-  model_.rim_speed_coefficients(chi, d1, d2);  // r_i φ̇_i = d1_i ω1 + d2_i ω2   (eq. (2.4))
+  model_.rim_speed_coefficients_at(s, c, d1, d2);  // r_i φ̇_i = d1_i ω1 + d2_i ω2   (eq. (2.4))
   // ∂d1_i/∂χ (d2 is constant).
-  const double s = deterministic::sin(chi);
-  const double c = deterministic::cos(chi);
   const CartParameters& p = model_.parameters();
   const double a_over_l = p.rear_half_track / p.wheelbase;
   const double cf_over_l = p.front_half_track / p.wheelbase;
