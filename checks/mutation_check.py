@@ -282,6 +282,14 @@ MUTATIONS = [
         "if (false) {",
         [("bag_file_claim_test", "*")],
     ),
+    Mutation(
+        "linear_mode_error_unweighted_out",
+        "the adaptive control's estimate drops the linearised error (B.55): a ringing stiff mode is stepped over unseen",
+        "include/birkhoff_cart/core/integrators/collocation_error_estimate.h",
+        "    if (memory.linear_mode_error) {",
+        "    if (false) {",
+        [("adaptive_step_control_test", "*SteppedOver*")],
+    ),
 ]
 
 

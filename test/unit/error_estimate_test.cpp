@@ -17,6 +17,10 @@
 // is generated from these steps (generated_docs.h).
 #include <gtest/gtest.h>
 
+#include <unsupported/Eigen/MatrixFunctions>
+
+#include <Eigen/LU>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -28,6 +32,8 @@
 #include <vector>
 
 #include "birkhoff_cart/core/integrators/diagnostics.h"
+#include "birkhoff_cart/core/integrators/gauss_legendre_tableau.h"
+#include "birkhoff_cart/core/integrators/linear_mode_error.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
 #include "birkhoff_cart/core/run/reference_solution.h"
 #include "birkhoff_cart/core/run/run_summary.h"
@@ -368,6 +374,90 @@ TEST(LocalErrorEstimate, RecordKeepsLastLargestAndSumAndResetForgetsThem) {
   EXPECT_EQ(simulation.statistics().steps_with_error_estimate, 2u);
   simulation.reset();
   EXPECT_FALSE(has_local_error_estimate(simulation.statistics()));
+}
+
+// ----------------------------------------------------------------------------------------------
+// The linearised error (B.54): what the defect estimate cannot see.
+
+/// The s-stage Gauss step's own error on ẇ = J w + c from a start rate F: h (ψ_s(hJ) − φ₁(hJ)) F, with
+/// ψ_s from the collocation equations themselves (K = (I − h A ⊗ J)⁻¹ (1 ⊗ F), Δw = h Σ bᵢ Kᵢ) and φ₁
+/// from Eigen's matrix exponential of the bordered matrix: independent of linear_mode_error's Padé sums.
+template <int Stages>
+Eigen::Vector4d linear_gauss_step_error(const Eigen::Matrix4d& jacobian, const Eigen::Vector4d& rate, double h) {
+  const GaussLegendreTableau& tableau = gauss_legendre_tableau(Stages);
+  Eigen::Matrix<double, 4 * Stages, 4 * Stages> system = Eigen::Matrix<double, 4 * Stages, 4 * Stages>::Identity();
+  Eigen::Matrix<double, 4 * Stages, 1> right;
+  for (int i = 0; i < Stages; ++i) {
+    right.template segment<4>(4 * i) = rate;
+    for (int j = 0; j < Stages; ++j) system.template block<4, 4>(4 * i, 4 * j) -= h * tableau.coefficients[i][j] * jacobian;
+  }
+  const Eigen::Matrix<double, 4 * Stages, 1> stages = system.partialPivLu().solve(right);
+  Eigen::Vector4d collocation = Eigen::Vector4d::Zero();
+  for (int i = 0; i < Stages; ++i) collocation += h * tableau.weights[i] * stages.template segment<4>(4 * i);
+  Eigen::Matrix<double, 5, 5> bordered = Eigen::Matrix<double, 5, 5>::Zero();
+  bordered.topLeftCorner<4, 4>() = h * jacobian;
+  bordered.topRightCorner<4, 1>() = h * rate;
+  const Eigen::Matrix<double, 5, 5> exact = bordered.exp();
+  return collocation - exact.topRightCorner<4, 1>();
+}
+
+/// A stiff hinge's steering mode (400 rad/s, lightly damped) beside a slow one, coupled.
+Eigen::Matrix4d stiff_and_slow_modes() {
+  Eigen::Matrix4d jacobian;
+  jacobian << 0.0, 1.0, 0.0, 0.0,
+      -400.0 * 400.0, -5.0, 0.3, 0.0,
+      0.0, 0.0, 0.0, 1.0,
+      2.0, 0.0, -1.7, -0.2;
+  return jacobian;
+}
+
+template <int Stages>
+void expect_linear_mode_error_is_the_steps_error() {
+  const Eigen::Matrix4d jacobian = stiff_and_slow_modes();
+  const Eigen::Vector4d rate(0.7, -120.0, 0.4, -0.9);
+  const double stiffness = 400.0;  // ρ(J) [1/s]
+  // Smooth motion (h·ρ ≤ 0.4, where the step's error is above round-off): e_L is the step's error to
+  // leading order, and of order 2s + 1.
+  const std::vector<double> smooth = Stages == 4 ? std::vector<double>{0.2, 0.4} : std::vector<double>{0.1, 0.2, 0.4};
+  for (double h_rho : smooth) {
+    const double h = h_rho / stiffness;
+    const Eigen::Vector4d estimated = linear_mode_error<Stages>(jacobian, rate, h, 0.0);
+    const Eigen::Vector4d exact = linear_gauss_step_error<Stages>(jacobian, rate, h);
+    std::printf("[ measured ] s = %d, h*rho = %.2g: |e_L| %.3e, |step error| %.3e\n", Stages, h_rho, estimated.norm(), exact.norm());
+    EXPECT_NEAR(estimated.norm() / exact.norm(), 1.0, 0.05) << "s = " << Stages << ", h*rho = " << h_rho;
+  }
+  const double larger = Stages == 4 ? 0.4 : 0.1;  // h·ρ of the longer of two steps, the other half of it
+  const double halved = linear_mode_error<Stages>(jacobian, rate, larger / stiffness, 0.0).norm() /
+                        linear_mode_error<Stages>(jacobian, rate, 0.5 * larger / stiffness, 0.0).norm();
+  std::printf("[ measured ] s = %d: e_L falls %.1fx when h halves (order %.2f)\n", Stages, halved, std::log2(halved));
+  EXPECT_NEAR(std::log2(halved), 2 * Stages + 1, 0.4) << "s = " << Stages << ": the order of e_L";
+  // A step over the mode (h·ρ ≫ 1): the error is the mode's own size, and e_L reads it within a few
+  // times (R_s − R_{s+1} tends to twice the mode's share where the true step damps it).
+  for (double h_rho : {10.0, 100.0, 1000.0}) {
+    const double h = h_rho / stiffness;
+    const double estimated = linear_mode_error<Stages>(jacobian, rate, h, 0.0).norm();
+    const double exact = linear_gauss_step_error<Stages>(jacobian, rate, h).norm();
+    std::printf("[ measured ] s = %d, h*rho = %.0f: |e_L| %.3e, |step error| %.3e\n", Stages, h_rho, estimated, exact);
+    EXPECT_GE(estimated, 0.2 * exact) << "s = " << Stages << ", h*rho = " << h_rho;
+    EXPECT_LE(estimated, 5.0 * exact) << "s = " << Stages << ", h*rho = " << h_rho;
+  }
+}
+
+TEST(LinearModeError, IsTheGaussStepsOwnErrorOnLinearDynamicsWhereTheDefectReadsZero) {
+  expect_linear_mode_error_is_the_steps_error<2>();
+  expect_linear_mode_error_is_the_steps_error<3>();
+  expect_linear_mode_error_is_the_steps_error<4>();
+}
+
+TEST(LinearModeError, IsNotComputedWhereItsLeadingTermCannotMatter) {
+  const Eigen::Matrix4d jacobian = stiff_and_slow_modes();
+  const Eigen::Vector4d rate(0.7, -120.0, 0.4, -0.9);
+  const double h = 0.1 / 400.0;  // h·ρ = 0.1
+  const Eigen::Vector4d full = linear_mode_error<4>(jacobian, rate, h, 0.0);
+  ASSERT_GT(full.norm(), 0.0);
+  // The leading term c_4 ‖(hJ)⁸ hF‖ bounds it here: a `negligible` above it returns exactly zero.
+  EXPECT_TRUE(linear_mode_error<4>(jacobian, rate, h, 10.0 * full.cwiseAbs().maxCoeff()).isZero(0.0));
+  EXPECT_TRUE(linear_mode_error<4>(jacobian, rate, h, 0.1 * full.cwiseAbs().maxCoeff()).isApprox(full));
 }
 
 }  // namespace

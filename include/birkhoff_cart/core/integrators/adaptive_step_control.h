@@ -7,7 +7,8 @@
 //
 // with τ [1/s] the error per second the estimate is aimed at, in ê's units (absolute below 1 SI
 // unit, relative above; error_estimate.h): the adapter derives it from the position tolerance by
-// the member's tolerance proportionality (eq. (B.53)). The growth reads the larger of the last two
+// the member's tolerance proportionality (eq. (B.53)); for the Gauss members ê includes the step's
+// weighted linearised error (B.55), which sees a stiff mode a step would jump over. The growth reads the larger of the last two
 // ratios ê/(τh); the accepted retry after a rejection does not grow, and while ê reads zero after a
 // rejection the steps grow by at most ceiling_growth a step (birkhoffian.md §12.1). A step that is
 // rejected — by the estimate, or because its stage solve did not converge, met a non-finite value
@@ -145,6 +146,7 @@ class AdaptiveStepControl {
       const auto saved_history = grid_.memory.history();
       StepStatistics trial;
       grid_.memory.stage_change_limit = settings_.stage_change_fraction * settings_.error_per_unit_step * h;
+      grid_.memory.linear_mode_error = true;  // ê sees a stiff mode the step would jump over (B.55)
       bool solved = true;
       try {
         system_traits::begin_step(system, time());

@@ -7,7 +7,9 @@
 // passive coordinates. Cost: one rhs evaluation F(w⁺) and one passive evaluation g(z⁺, y⁺) a step
 // (first same as last: they are the next step's F(w) and g(z, y)), from one evaluation of what they
 // share where the system offers it (darboux_and_passive_rates, system_traits.h). It vanishes identically on linear
-// autonomous ẇ = Lw (the defect is then a multiple of the node polynomial, whose end values cancel).
+// autonomous ẇ = Lw (the defect is then a multiple of the node polynomial, whose end values cancel):
+// under the adaptive control (memory.linear_mode_error) the step's linearised error, weighted, is
+// added to it, so that a stiff mode a step would jump over is seen (linear_mode_error.h, (B.54)–(B.55)).
 #pragma once
 
 #include <Eigen/Core>
@@ -22,6 +24,7 @@
 #include "birkhoff_cart/core/integrators/diagnostics.h"
 #include "birkhoff_cart/core/integrators/collocation_memory.h"
 #include "birkhoff_cart/core/integrators/gauss_legendre_tableau.h"
+#include "birkhoff_cart/core/integrators/linear_mode_error.h"
 #include "birkhoff_cart/core/integrators/newton.h"
 #include "birkhoff_cart/core/integrators/system_traits.h"
 
@@ -97,6 +100,15 @@ LocalErrorVectors<System, S> collocation_error_vectors(const System& system, con
       ++statistics.rhs_evaluations;
     }
     e_w = darboux_error(converged_rates);
+  }
+  // Under the adaptive control, the linearised error the defect cannot see, weighted (B.54)–(B.55):
+  // ê = ‖e + w_L e_L‖, computed where w_L e_L's leading term could reach a hundredth of e.
+  if constexpr (std::is_same_v<S, double>) {
+    if (memory.linear_mode_error) {
+      const double defect = std::max(e_w.cwiseAbs().maxCoeff(), round_off);
+      e_w += kLinearModeWeight *
+             linear_mode_error<Stages>(memory.jacobian, start_rate, h, 0.01 * defect / kLinearModeWeight);
+    }
   }
 
   // e_z: through the chart (linear: directly; else z⁺ − D⁻¹(w⁺ − e_w)).

@@ -49,6 +49,11 @@ struct CollocationMemory {
   /// the local error norm ê (absolute below 1, relative above; error_estimate.h): the accuracy a step
   /// control's tolerance needs (gauss_stage_solver.h). 0: converge to round-off.
   double stage_change_limit = 0.0;
+  /// The local error estimate adds the step's weighted linearised error w_L e_L (eqs. (B.54)–(B.55),
+  /// linear_mode_error.h), which the defect (B.37) cannot see: the adaptive control sets it, for the
+  /// stiff modes a step may jump over. false: the estimate (B.37) alone (fixed steps, the reversible
+  /// control, the diagnostics).
+  bool linear_mode_error = false;
 
   /// The part of the memory a rejected step must give back (stage history and end rate; J and the
   /// Newton inverses stay: they are keyed by h and remain a good approximation).
