@@ -45,9 +45,9 @@ constexpr double linear_mode_error_constant(int stages) {
 /// w_L of (B.55): the weight of e_L in the adaptive control's estimate ê = ‖e + w_L e_L‖ [-]. The
 /// control must see a ringing stiff mode before it jumps over it, not resolve the mode to the
 /// tolerance: a steering mode reaches the position of B at a small fraction of its amplitude, and
-/// with w_L = 1 the hinges ended 10⁻⁵–10⁻⁶ of their tolerance for up to 40 % more steps. From 10⁻⁵ on
+/// with w_L = 1 very_stiff_hinge ended 10⁻⁴–10⁻⁶ of its tolerance for up to 45 % more steps. From 10⁻⁵ on
 /// (swept over 10⁻⁶ … 1: CHANGELOG 0.6.0), very_stiff_hinge ends within twice its tolerance for every
-/// Gauss member, for at most 2 % more evaluations; the other scenes' grids do not move.
+/// Gauss member, for at most 2 % more evaluations; off the two hinges no shipped scene's grid moves.
 constexpr double kLinearModeWeight = 1e-5;
 
 /// e_L of (B.54) for the s-stage Gauss member over h [s], from J = ∂F/∂w [1/s] and the start rate F
