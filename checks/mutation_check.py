@@ -290,6 +290,14 @@ MUTATIONS = [
         "    if (false) {",
         [("adaptive_step_control_test", "*SteppedOver*")],
     ),
+    Mutation(
+        "torque_memo_keeps_first_value",
+        "a torque profile's memo fills an entry once and never compares the time again: stale torques",
+        "include/birkhoff_cart/core/physics/effects/torque_source.h",
+        "    if (entry.time_bits != bits) {",
+        "    if (entry.time_bits == 0x7FF8000000000000ULL) {",
+        [("effects_test", "TorqueSource*")],
+    ),
 ]
 
 

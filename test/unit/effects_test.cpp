@@ -23,6 +23,7 @@
 #include "birkhoff_cart/core/physics/effects/steering_damping.h"
 #include "birkhoff_cart/core/physics/effects/steering_stiffness.h"
 #include "birkhoff_cart/core/physics/effects/steering_torque.h"
+#include "birkhoff_cart/core/physics/effects/torque_source.h"
 #include "birkhoff_cart/core/scene/scene.h"
 #include "all_effects.h"
 
@@ -424,6 +425,39 @@ TEST(EffectSet, TheCallersSinAndCosOfTheSteeringAngleGiveTheSameLoadsBitForBit) 
       wrong.steering_cos = -given.steering_cos;
       EXPECT_NE(all.evaluate(wrong).force(0), computed.force(0)) << "the given cos chi is read";
     }
+  }
+}
+
+TEST(TorqueSource, RemembersOnlyWhatItsProfileGivesAtThatTimeBitForBit) {
+  // A smooth profile's values are remembered by time (torque_source.h): a stage solve asks the same
+  // stage times in every iteration. Asked in any order, with repeats, with times that share a memo
+  // entry and from a copy, the answer is the profile's own at that time, bit for bit; and a time
+  // never asked (a NaN, the empty entries' key) gives the profile's NaN, not a remembered value.
+  TorqueProfile cosine;
+  cosine.kind = TorqueProfile::Kind::kCosine;
+  cosine.amplitude = 3.5;
+  cosine.frequency = 0.7;
+  cosine.phase = 0.2;
+  TorqueProfile switch_off;
+  switch_off.kind = TorqueProfile::Kind::kSmoothSwitchOff;
+  switch_off.initial = 40.0;
+  switch_off.switch_off_time = 4.0;
+  switch_off.width = 0.5;
+  std::mt19937_64 random(20261130);
+  std::uniform_real_distribution<double> time(0.0, 10.0);
+  for (const TorqueProfile& profile : {cosine, switch_off}) {
+    TorqueSource source(profile);
+    std::vector<double> times(64);
+    for (double& t : times) t = time(random);
+    std::uniform_int_distribution<std::size_t> pick(0, times.size() - 1);
+    for (int ask = 0; ask < 5000; ++ask) {
+      const double t = times[pick(random)];
+      const double expected = profile.at(t);
+      const double got = (ask % 7 == 0) ? TorqueSource(source).at(t) : source.at(t);
+      ASSERT_EQ(std::memcmp(&expected, &got, sizeof(double)), 0) << "at t = " << t << ", ask " << ask;
+    }
+    EXPECT_TRUE(std::isnan(TorqueSource(profile).at(std::numeric_limits<double>::quiet_NaN())));
+    EXPECT_TRUE(std::isnan(source.at(std::numeric_limits<double>::quiet_NaN())));
   }
 }
 
