@@ -261,7 +261,7 @@ MUTATIONS = [
         "a side step to an output row converges its stage solve to round-off instead of the accuracy the "
         "tolerance needs: the same rows, several more iterations each",
         "src/core/cart_binding/adaptive_cart_stepper.h",
-        "side_memory_.start_side_step_from(grid_memory, stage_change_per_unit_step_ * (target - start) / pieces,",
+        "side_memory_.start_side_step_from(grid_memory, side_stage_change_per_unit_step_ * (target - start) / pieces,",
         "side_memory_.start_side_step_from(grid_memory, 0.0 * (target - start) / pieces,",
         [("adaptive_step_control_test", "SideSteps.*")],
     ),

@@ -67,7 +67,8 @@ class AdaptiveCartStepperAdapter final
       : Base(model, effects, "adaptive", settings.position_tolerance), effects_(&effects), control_(stepper, control_settings(settings)),
         estimate_free_stepper_(estimate_free_stepper),
         global_error_estimate_(settings.global_error_estimate),
-        stage_change_per_unit_step_(control_.settings().stage_change_fraction * control_.settings().error_per_unit_step) {}
+        stage_change_per_unit_step_(control_.settings().stage_change_fraction * control_.settings().error_per_unit_step),
+        side_stage_change_per_unit_step_(AdaptiveStepSettings{}.stage_change_fraction * control_.settings().error_per_unit_step) {}
 
   bool symmetric() const override { return Stepper::kSymmetric; }
 
@@ -204,7 +205,9 @@ class AdaptiveCartStepperAdapter final
   /// last step, so its stage solve starts from that step's stage points (interpolated, not an explicit
   /// start) and its J — where the grid has none, J at the grid point before, computed by the first
   /// side step in the grid step and kept for the others — and stops at the accuracy the tolerance
-  /// needs (κ·τ·h, eq. (B.49)), as a grid step does; it reads no ê (the run's ê is its grid's). A side
+  /// needs (κ·τ_a·h, eq. (B.49'), a hundredth of the aim: its error ends at its row, where a grid
+  /// step's carries on, so it need not converge to the grid's κ·τ·h); it reads no ê (the run's ê is
+  /// its grid's). A side
   /// step whose stage solve fails or
   /// lands on a spurious root (non-finite, or the energy balance broken) is retried in 2, 4, …
   /// 2^kMaxSideStepHalvings substeps, as the control retries a rejected attempt smaller.
@@ -224,7 +227,7 @@ class AdaptiveCartStepperAdapter final
       const int pieces = 1 << halvings;
       out.point = control_.previous();
       out.turns = control_.previous_turns();
-      side_memory_.start_side_step_from(grid_memory, stage_change_per_unit_step_ * (target - start) / pieces,
+      side_memory_.start_side_step_from(grid_memory, side_stage_change_per_unit_step_ * (target - start) / pieces,
                                         grid_memory.jacobian_valid ? nullptr : &side_jacobian_);
       try {
         for (int k = 1; k <= pieces; ++k) {
@@ -266,6 +269,7 @@ class AdaptiveCartStepperAdapter final
   double side_jacobian_at_ = std::numeric_limits<double>::quiet_NaN();
   bool global_error_estimate_;
   double stage_change_per_unit_step_;  ///< κ·τ: the stage solve stops at this·h [1/s] (B.49)
+  double side_stage_change_per_unit_step_;  ///< κ·τ_a: a side step's stage solve stops at this·h [1/s] (B.49')
   RichardsonShadow<Stepper, System, Carried> shadow_;
   Eigen::Vector2d carried_error_ = Eigen::Vector2d::Zero();  ///< estimate kept over the shadow's restarts [m]
   Eigen::Vector2d met_error_ = Eigen::Vector2d::Zero();      ///< (A.6) at the last meeting since then [m]
