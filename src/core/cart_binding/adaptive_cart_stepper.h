@@ -58,6 +58,8 @@ class AdaptiveCartStepperAdapter final
   static constexpr std::uint64_t kMaxInternalStepsPerOutput = 100000;
   /// A failed side step is retried in up to 2^kMaxSideStepHalvings substeps.
   static constexpr int kMaxSideStepHalvings = 6;
+  /// κ of (B.49) and (B.49') [-]: the grid's is rescaled to the asked τ in control_settings().
+  static constexpr double kStageChangeFraction = AdaptiveStepSettings{}.stage_change_fraction;
 
  public:
   /// `estimate_free_stepper`: the member without its ê, as the global error estimate's shadow and the
@@ -68,7 +70,7 @@ class AdaptiveCartStepperAdapter final
         estimate_free_stepper_(estimate_free_stepper),
         global_error_estimate_(settings.global_error_estimate),
         stage_change_per_unit_step_(control_.settings().stage_change_fraction * control_.settings().error_per_unit_step),
-        side_stage_change_per_unit_step_(AdaptiveStepSettings{}.stage_change_fraction * control_.settings().error_per_unit_step) {}
+        side_stage_change_per_unit_step_(kStageChangeFraction * control_.settings().error_per_unit_step) {}
 
   bool symmetric() const override { return Stepper::kSymmetric; }
 

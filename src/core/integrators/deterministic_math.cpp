@@ -24,12 +24,6 @@ struct LastValue {
   double value = 0.0;
 };
 
-std::uint64_t bits_of(double x) {
-  std::uint64_t bits;
-  std::memcpy(&bits, &x, sizeof bits);
-  return bits;
-}
-
 template <auto function>
 double remembered(double x, LastValue& last) {
   const std::uint64_t bits = bits_of(x);

@@ -17,12 +17,21 @@
 #pragma once
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 #include <Eigen/Core>
 #include <unsupported/Eigen/AutoDiff>
 
 namespace birkhoff_cart {
 namespace deterministic {
+
+/// The bits of x, for memos keyed on an argument bit for bit [-].
+inline std::uint64_t bits_of(double x) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  return bits;
+}
 
 double sin(double angle);   ///< [rad → -]
 double cos(double angle);   ///< [rad → -]

@@ -3,11 +3,11 @@
 
 #include <array>
 #include <cstdint>
-#include <cstring>
 #include <limits>
 #include <memory>
 #include <string>
 
+#include "birkhoff_cart/core/integrators/deterministic_math.h"
 #include "birkhoff_cart/core/physics/actuators/torque_actuator.h"
 #include "birkhoff_cart/core/physics/effects.h"
 #include "birkhoff_cart/core/physics/torque_profile.h"
@@ -35,8 +35,7 @@ class TorqueSource {
     if (profile_.kind != TorqueProfile::Kind::kCosine && profile_.kind != TorqueProfile::Kind::kSmoothSwitchOff) {
       return profile_.at(time);
     }
-    std::uint64_t bits;
-    std::memcpy(&bits, &time, sizeof bits);
+    const std::uint64_t bits = deterministic::bits_of(time);
     MemoEntry& entry = memo_[(bits * 0x9E3779B97F4A7C15ULL) >> (64 - kMemoBits)];  // Fibonacci hashing
     if (entry.time_bits != bits) {
       entry.value = profile_.at(time);
