@@ -149,8 +149,9 @@ def test_the_global_error_estimate_is_in_the_statistics_when_asked_for():
     assert np.array_equal(plain.run(), estimated.run())  # the same steps and rows
     assert math.isnan(plain.statistics()["global_error_estimate"])
     assert not plain.statistics()["global_error_estimate_in_range"]
-    # The whirl's error at 1e-7 m is about 5e-10 m (accuracy.md §4.5): within the estimate's band.
-    assert 1e-11 < estimated.statistics()["global_error_estimate"] < 1e-8
+    # The whirl's error at 1e-7 m is 6.7e-9 m (against gauss8 at a fixed 1 ms step); the estimate is
+    # within its band of it ([0.5, 10]×, accuracy.md §4.5): 1.4e-8 m.
+    assert 0.5 * 6.7e-9 < estimated.statistics()["global_error_estimate"] < 10 * 6.7e-9
     assert estimated.statistics()["global_error_estimate_in_range"]
     assert estimated.statistics()["rhs_evaluations"] > plain.statistics()["rhs_evaluations"]
     with pytest.raises(simulator.SceneError) as raised:

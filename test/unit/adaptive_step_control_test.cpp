@@ -1,6 +1,7 @@
 // Accuracy on demand (adaptive_step_control.h, reversible_step_control.h, dopri5_cart_stepper.h;
 // docs/birkhoffian.md §11–§12): a position tolerance drives every Birkhoffian member and dopri5 on
-// every shipped scene, the delivered error lands within 10× of it (for the Gauss members under the
+// every shipped scene, the delivered error lands within 2× of it under the adaptive control and 10× under
+// the reversible one (for the Gauss members under the
 // adaptive control also above 1/30 000 of it, with rejected attempts below a quarter of the accepted
 // steps) and the work falls as it loosens;
 // every accepted step meets its error per unit step, a rejected or failed attempt never reaches the
@@ -11,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <string>
@@ -76,7 +78,12 @@ bool time_dependent(const Scene& scene) {
 /// measured figures): the delivered error not below tolerance / this [-], and rejected attempts at
 /// most this share of the accepted steps [-].
 constexpr double kOverdeliveryBound = 3e4;
+/// The delivered error at most this many times the tolerance under each control [-].
+constexpr double kAdaptivePromise = 2.0;
+constexpr double kReversiblePromise = 10.0;
 constexpr double kRejectedShareBound = 0.25;
+/// A run of at most this many internal steps is at the start's floor of work [-].
+constexpr std::uint64_t kStartFloorSteps = 10;
 
 TEST(ToleranceProportionality, EveryShippedSceneEveryControl) {
   const std::vector<std::string> scenes = {"const_steer_torque", "default",      "drive_rr_drag",  "driven",
@@ -101,6 +108,7 @@ TEST(ToleranceProportionality, EveryShippedSceneEveryControl) {
       if (setting.control == StepControl::kReversible && time_dependent(scene)) continue;  // refused (tested below)
       std::vector<double> work;
       double loosest_error = 0.0;
+      std::uint64_t loosest_steps = 0;  // internal steps at the loosest tolerance [-]
       for (double tolerance : tolerances) {
         const RunEnd result = run(configured(scene, setting.member, setting.control, tolerance));
         const double error = position_error(result.end, reference);
@@ -109,7 +117,11 @@ TEST(ToleranceProportionality, EveryShippedSceneEveryControl) {
                     static_cast<unsigned long long>(result.statistics.rhs_evaluations),
                     static_cast<unsigned long long>(result.statistics.rejected_steps),
                     static_cast<unsigned long long>(result.statistics.internal_steps));
-        EXPECT_LE(error, 10.0 * tolerance + 1e-10) << name << " " << setting.member << " at " << tolerance << " m";
+        // The adaptive control's promise is 2× (accuracy.md §4.3: worst measured 1.4×, gauss6 on
+        // stiff_hinge at 1e-7 m); the reversible control's 10× (3.4× measured: gauss8 on paper_special
+        // at 1e-7 m in the autonomous form).
+        const double promise = setting.control == StepControl::kAdaptive ? kAdaptivePromise : kReversiblePromise;
+        EXPECT_LE(error, promise * tolerance + 1e-10) << name << " " << setting.member << " at " << tolerance << " m";
         if (setting.control == StepControl::kAdaptive && setting.member != "dopri5") {
           // The Gauss members aim at the tolerance (eq. (B.53)), not orders below it — except where
           // the motion is exact at any step (driven: a straight coast), and judged only where the
@@ -123,7 +135,10 @@ TEST(ToleranceProportionality, EveryShippedSceneEveryControl) {
               << name << " " << setting.member << " at " << tolerance << " m";
         }
         work.push_back(static_cast<double>(result.statistics.rhs_evaluations));
-        if (work.size() == 1) loosest_error = error;
+        if (work.size() == 1) {
+          loosest_error = error;
+          loosest_steps = result.statistics.internal_steps;
+        }
       }
       // The work falls as the tolerance loosens — but where the loosest tolerance's run already
       // meets the tightest (straight coasting is exact for every method), and for the reversible
@@ -132,8 +147,11 @@ TEST(ToleranceProportionality, EveryShippedSceneEveryControl) {
       // its work falls 2.9× from 1e-7 to 1e-3 m: docs/results.md).
       // An eighth-order member whose error follows the tolerance needs (10⁴)^{1/8} = 3.2× fewer steps
       // at 1e-3 m than at 1e-7 m, before the start's floor of steps: 0.7 for it (accuracy.md §4.1).
+      // A loosest run of at most kStartFloorSteps steps is at that floor (const_steer_torque, gauss6:
+      // 5 steps and 97 rhs at 1e-3 m, 14 and 169 at 1e-7 m; paper_special, dopri5: 10 and 26 steps).
       const double falls_to = setting.member == "birkhoff_gauss8" ? 0.7 : 0.5;
-      if (loosest_error > tolerances.back() && setting.control != StepControl::kReversible) {
+      if (loosest_error > tolerances.back() && setting.control != StepControl::kReversible &&
+          loosest_steps > kStartFloorSteps) {
         EXPECT_LE(work.front(), falls_to * work.back()) << name << " " << setting.member << ": the work at 1e-3 m against 1e-7 m";
       }
     }

@@ -14,7 +14,8 @@
 // summed, cancel to O(h⁴) since Σγᵢ³ = 0); the
 // estimate only observes (bit-for-bit trajectory with it on or off); a new command torque is not
 // mistaken for the last step's end rate. The estimate-to-true ratios are printed; docs/accuracy.md §1's table
-// is generated from these steps (generated_docs.h).
+// is generated from these steps (generated_docs.h). The passive coordinates count absolutely, the
+// Birkhoffian variables relatively above 1 SI unit (A.1).
 #include <gtest/gtest.h>
 
 #include <unsupported/Eigen/MatrixFunctions>
@@ -31,7 +32,9 @@
 #include <string>
 #include <vector>
 
+#include "birkhoff_cart/core/physics/cart_birkhoffian.h"
 #include "birkhoff_cart/core/integrators/diagnostics.h"
+#include "birkhoff_cart/core/integrators/error_estimate.h"
 #include "birkhoff_cart/core/integrators/gauss_legendre_tableau.h"
 #include "birkhoff_cart/core/integrators/linear_mode_error.h"
 #include "birkhoff_cart/core/cart_binding/cart_stepper.h"
@@ -458,6 +461,37 @@ TEST(LinearModeError, IsNotComputedWhereItsLeadingTermCannotMatter) {
   // The leading term c_4 ‖(hJ)⁸ hF‖ bounds it here: a `negligible` above it returns exactly zero.
   EXPECT_TRUE(linear_mode_error<4>(jacobian, rate, h, 10.0 * full.cwiseAbs().maxCoeff()).isZero(0.0));
   EXPECT_TRUE(linear_mode_error<4>(jacobian, rate, h, 0.1 * full.cwiseAbs().maxCoeff()).isApprox(full));
+}
+
+// ê of (A.1) (accuracy.md §1): the Birkhoffian variables relatively above 1 SI unit, the passive
+// coordinates absolutely whatever their size — the positions, the wheel angles, the loads' work W and
+// impulse I2, which grow through a run (W reaches thousands of joules on a drive). Measured relatively,
+// as odeint's norm, a 1 nJ step error in a W of 2000 J read as 5e-13 and a step control let it grow.
+TEST(LocalErrorEstimate, ThePassiveCoordinatesCountAbsolutelyTheBirkhoffianRelativelyAboveOne) {
+  using System = CartAutonomousBirkhoffian;
+  StateVector<System, double> z_start;
+  z_start << 30.0, 0.2, 300.0, 0.5;  // π1 [m], χ [rad], p1 [kg·m/s], p2 [kg·m²/s]
+  PassiveVector<System, double> y_start;
+  y_start << 1e4, -1e4, 3.0, 2000.0, 2000.0, 2100.0, 2100.0, 2000.0, 50.0;  // x, y, θ, φ1..φ4, W, I2
+  const auto norm = [&](const StateVector<System, double>& z_error, const PassiveVector<System, double>& y_error) {
+    return local_error_norm<System, double>(z_start, y_start, z_error, y_error);
+  };
+  const StateVector<System, double> no_z_error = StateVector<System, double>::Zero();
+  const PassiveVector<System, double> no_y_error = PassiveVector<System, double>::Zero();
+  for (int i = 0; i < System::kPassiveDimension; ++i) {
+    PassiveVector<System, double> y_error = no_y_error;
+    y_error(i) = -1e-9;
+    EXPECT_EQ(norm(no_z_error, y_error), 1e-9) << "passive " << i;
+  }
+  StateVector<System, double> z_error = no_z_error;
+  z_error(2) = 3e-7;  // on p1 = 300 kg·m/s: relative
+  EXPECT_DOUBLE_EQ(norm(z_error, no_y_error), 1e-9);
+  z_error(2) = 0.0;
+  z_error(1) = 1e-9;  // on χ = 0.2 rad: absolute below 1
+  EXPECT_EQ(norm(z_error, no_y_error), 1e-9);
+  PassiveVector<System, double> y_error = no_y_error;
+  y_error(0) = std::nan("");
+  EXPECT_TRUE(std::isnan(norm(no_z_error, y_error)));
 }
 
 }  // namespace

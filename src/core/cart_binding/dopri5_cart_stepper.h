@@ -40,10 +40,13 @@ class Dopri5RunCartStepper final : public CartStepper {
   using Dense = boost::numeric::odeint::dense_output_runge_kutta<Controlled>;
 
  public:
-  /// `tolerance`: absolute and relative tolerance per step [-] (≥ DormandPrince5::kMinTolerance).
-  Dopri5RunCartStepper(double tolerance, const CartModel& model, const EffectSet& effects)
-      : tolerance_(DormandPrince5(tolerance).tolerance()), model_(&model), system_(model, effects),
-        dense_(Controlled(Checker(tolerance_, tolerance_, &trial_estimate_))), instants_(effects) {}
+  /// `tolerance`: absolute and relative tolerance per step [-] (≥ DormandPrince5::kMinTolerance);
+  /// `passive_absolute`: the passive coordinates (the positions) are held to it absolutely
+  /// (NotingErrorChecker; the adaptive control's position tolerance).
+  Dopri5RunCartStepper(double tolerance, const CartModel& model, const EffectSet& effects,
+                       bool passive_absolute = false)
+      : tolerance_(DormandPrince5(tolerance).tolerance()), passive_absolute_(passive_absolute), model_(&model),
+        system_(model, effects), dense_(Controlled(checker(&trial_estimate_))), instants_(effects) {}
 
   const std::string& name() const override { return name_; }
   int order() const override { return DormandPrince5::kOrder; }
@@ -117,10 +120,13 @@ class Dopri5RunCartStepper final : public CartStepper {
   }
 
  private:
+  Checker checker(double* estimate) const {
+    return Checker(tolerance_, tolerance_, estimate, kBirkhoffianSize, passive_absolute_);
+  }
   /// x(target) by controlled steps from the accepted step's start (exact to the method's order,
   /// the run itself untouched).
   void side_step(double target, const JointRates& rates, Joint& x) {
-    Controlled controlled(Checker(tolerance_, tolerance_, &side_estimate_));
+    Controlled controlled(checker(&side_estimate_));
     x = dense_.previous_state();
     double t = dense_.previous_time();
     double dt = target - t;
@@ -163,6 +169,7 @@ class Dopri5RunCartStepper final : public CartStepper {
 
   const std::string name_ = DormandPrince5::name();
   double tolerance_;  ///< [-]
+  bool passive_absolute_;  ///< the passive coordinates held to the tolerance absolutely
   const CartModel* model_;
   CartAutonomousBirkhoffian system_;
   double trial_estimate_ = 0.0;  ///< ê of the latest trial step [-] (the checker writes it)

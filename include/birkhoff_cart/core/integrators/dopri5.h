@@ -56,7 +56,14 @@ namespace birkhoff_cart {
 namespace dopri5_detail {
 
 /// odeint's default error checker that first notes ê of the raw error vector x̂ − x (before the
-/// default checker overwrites it with the tolerance-scaled one) in *trial_estimate.
+/// default checker overwrites it with the tolerance-scaled one) in *trial_estimate, in the norm of
+/// every integrator (error_estimate.h, (A.1)): the components from `passive_from` on are passive
+/// coordinates, measured absolutely.
+///
+/// `passive_absolute`: the step is also accepted on that norm's split — the passive components by
+/// |x̂ᵢ − xᵢ| ≤ ε_abs, the others by odeint's ε_abs + ε_rel (|xᵢ| + |h ẋᵢ|) — instead of odeint's
+/// relative measure of every component (the adaptive control's position tolerance is absolute:
+/// docs/accuracy.md §4.4).
 template <class Value, class Algebra, class Operations>
 class NotingErrorChecker {
  public:
@@ -65,19 +72,30 @@ class NotingErrorChecker {
   using operations_type = Operations;
   using Default = boost::numeric::odeint::default_error_checker<Value, Algebra, Operations>;
 
-  NotingErrorChecker(Value eps_abs, Value eps_rel, double* trial_estimate)
-      : default_(eps_abs, eps_rel), trial_estimate_(trial_estimate) {}
+  NotingErrorChecker(Value eps_abs, Value eps_rel, double* trial_estimate, std::size_t passive_from,
+                     bool passive_absolute = false)
+      : default_(eps_abs, eps_rel), eps_abs_(eps_abs), eps_rel_(eps_rel), trial_estimate_(trial_estimate),
+        passive_from_(passive_from), passive_absolute_(passive_absolute) {}
 
   template <class State, class Deriv, class Err, class Time>
   Value error(Algebra& algebra, const State& x_old, const Deriv& dxdt_old, Err& x_err, Time dt) const {
-    double estimate = 0.0;  // ê = maxᵢ |x̂ᵢ − xᵢ| / max(1, |xᵢ(tₖ)|)
+    double estimate = 0.0;  // ê = max(maxᵢ |x̂ᵢ − xᵢ| / max(1, |xᵢ(tₖ)|) over z, maxⱼ |x̂ⱼ − xⱼ| over y)
     for (std::size_t i = 0; i < x_err.size(); ++i) {
-      const double component = std::abs(x_err[i]) / std::max(1.0, std::abs(x_old[i]));
+      const double weight = i < passive_from_ ? std::max(1.0, std::abs(x_old[i])) : 1.0;
+      const double component = std::abs(x_err[i]) / weight;
       estimate = std::isnan(component) ? component : std::max(estimate, component);
       if (std::isnan(estimate)) break;
     }
     *trial_estimate_ = estimate;
-    return default_.error(algebra, x_old, dxdt_old, x_err, dt);
+    if (!passive_absolute_) return default_.error(algebra, x_old, dxdt_old, x_err, dt);
+    Value error = 0;
+    for (std::size_t i = 0; i < x_err.size(); ++i) {
+      const Value scale = i < passive_from_ ? std::abs(x_old[i]) + std::abs(dt * dxdt_old[i]) : Value(0);
+      const Value component = std::abs(x_err[i]) / (eps_abs_ + eps_rel_ * scale);
+      error = std::isnan(component) ? component : std::max(error, component);
+      if (std::isnan(error)) break;
+    }
+    return error;
   }
   template <class State, class Deriv, class Err, class Time>
   Value error(const State& x_old, const Deriv& dxdt_old, Err& x_err, Time dt) const {
@@ -87,7 +105,11 @@ class NotingErrorChecker {
 
  private:
   Default default_;
+  Value eps_abs_;
+  Value eps_rel_;
   double* trial_estimate_;
+  std::size_t passive_from_;  ///< the first passive component
+  bool passive_absolute_;
 };
 
 }  // namespace dopri5_detail
@@ -186,7 +208,7 @@ class DormandPrince5 {
     using Dopri5 = odeint::runge_kutta_dopri5<Joint>;
     using Checker = dopri5_detail::NotingErrorChecker<double, typename Dopri5::algebra_type,
                                                       typename Dopri5::operations_type>;
-    DeterministicControlled<Dopri5, Checker> controlled(Checker(tolerance_, tolerance_, &trial_estimate));
+    DeterministicControlled<Dopri5, Checker> controlled(Checker(tolerance_, tolerance_, &trial_estimate, n));
     // First internal step: the carried guess (a magnitude), with the sign of h (h < 0 runs backwards).
     const double first_guess = step_size_guess_ > 0.0 ? std::copysign(step_size_guess_, h) : h;
     try {
