@@ -10,12 +10,12 @@
 //
 //   ê = max( maxᵢ |e_zᵢ| / max(1, |zᵢ(tₖ)|),  maxⱼ |e_yⱼ| ).                                   (A.1)
 //
-// The passive coordinates are the positions the rates carry along (the cart's x, y, heading, wheel
-// angles, arc length): their rates do not depend on where they are, so neither does a step's error in
-// them, and a position tolerance is absolute. A relative measure would allow a cart 100 m from the
-// origin a 100× larger step error in its position than at the origin (so measured, dopri5 under the
-// adaptive control ends 9–10× its tolerance on very_stiff_hinge, 189 m travelled, and 1.6–5.4× on
-// default, 134 m; birkhoff_gauss8 up to 9.8× on stiff_hinge: docs/accuracy.md §1).
+// The passive coordinates are what the rates carry along (the cart's x, y, heading, wheel angles, and
+// the loads' work W and impulse I2): their rates do not depend on them, so neither does a step's error
+// in them. A relative measure lets the step errors of those that grow through a run grow with them
+// (W above all: thousands of joules on a drive); so measured, dopri5 under the adaptive control ends
+// 9–10× its tolerance on very_stiff_hinge and birkhoff_gauss8 up to 9.8× on stiff_hinge
+// (docs/accuracy.md §1).
 //
 // Generic in the scalar S (double or an AD jet): only the values are used.
 #pragma once
