@@ -291,6 +291,17 @@ MUTATIONS = [
         [("adaptive_step_control_test", "*SteppedOver*")],
     ),
     Mutation(
+        "passive_coordinates_measured_relatively",
+        "ê measures the passive coordinates relatively above 1 SI unit again (accuracy.md (A.1)): the step "
+        "errors of the loads' work and the wheel angles grow with them, and the stiff hinge ends beyond twice "
+        "its tolerance",
+        "include/birkhoff_cart/core/integrators/error_estimate.h",
+        "  const double y_norm = absolute_max_norm(y_error);",
+        "  const double y_norm = weighted_max_norm(y_start, y_error);",
+        [("error_estimate_test", "*PassiveCoordinatesCountAbsolutely*"),
+         ("adaptive_step_control_test", "ToleranceProportionality.*")],
+    ),
+    Mutation(
         "torque_memo_keeps_first_value",
         "a torque profile's memo fills an entry once and never compares the time again: stale torques",
         "include/birkhoff_cart/core/physics/effects/torque_source.h",

@@ -57,7 +57,7 @@ double absolute_max_norm(const ErrorVector& error) {
 /// does not weigh (the passive coordinates count absolutely); it stays in the signature so that
 /// every integrator reports its step the same way.
 template <class System, class S>
-double local_error_norm(const StateVector<System, S>& z_start, const PassiveVector<System, S>& /*y_start*/,
+double local_error_norm(const StateVector<System, S>& z_start, [[maybe_unused]] const PassiveVector<System, S>& y_start,
                         const StateVector<System, S>& z_error, const PassiveVector<System, S>& y_error) {
   const double z_norm = weighted_max_norm(z_start, z_error);
   const double y_norm = absolute_max_norm(y_error);
