@@ -5,9 +5,8 @@
 //   accept when ê ≤ τ·|h|      (error per unit step)                                           (B.46)
 //   h_new = h · min(α_max, max(α_min, 0.9·(τ|h|/ê)^{1/(q−1)}))   (ê ∝ h^q)                     (B.47)
 //
-// with τ [1/s] the error per second the estimate is aimed at, in ê's units (absolute below 1 SI
-// unit, relative above; error_estimate.h): the adapter derives it from the position tolerance by
-// the member's tolerance proportionality (eq. (B.53)); for the Gauss members ê includes the step's
+// with τ [1/s] the error per second the estimate is aimed at, in ê's units (error_estimate.h, (A.1)):
+// the adapter derives it from the position tolerance by the member's tolerance proportionality (eq. (B.53)); for the Gauss members ê includes the step's
 // weighted linearised error (B.55), which sees a stiff mode a step would jump over. The growth reads the larger of the last two
 // ratios ê/(τh); the accepted retry after a rejection does not grow, and while ê reads zero after a
 // rejection the steps grow by at most ceiling_growth a step (birkhoffian.md §12.1). A step that is

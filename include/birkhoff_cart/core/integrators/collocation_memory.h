@@ -46,7 +46,7 @@ struct CollocationMemory {
   PassiveVector<System, double> end_passive_rate = PassiveVector<System, double>::Zero();   ///< g(z⁺, y⁺, tₖ₊₁)
 
   /// The stage solve may stop once every component's stage change is below this, in the units of
-  /// the local error norm ê (absolute below 1, relative above; error_estimate.h): the accuracy a step
+  /// the Birkhoffian variables' weights of ê (absolute below 1, relative above; error_estimate.h): the accuracy a step
   /// control's tolerance needs (gauss_stage_solver.h). 0: converge to round-off.
   double stage_change_limit = 0.0;
   /// The local error estimate adds the step's weighted linearised error w_L e_L (eqs. (B.54)–(B.55),

@@ -32,9 +32,9 @@ struct StepStatistics {
   double global_error_stiffness = 0.0;  ///< the largest h·ρ(J) of the shadow's steps [-]
 
   // The local error estimate (docs/accuracy.md): per step, the weighted max-norm
-  //   ê = maxᵢ |x̂ᵢ − xᵢ| / max(1, |xᵢ(tₖ)|)
-  // over the Birkhoffian variables z = (π1, χ, p1, p2) and the passive coordinates
-  // y = (x, y, θ, φ1..φ4, W, I2) in SI units (absolute below 1 unit, relative above), where x̂ − x is
+  //   ê = max( maxᵢ |ẑᵢ − zᵢ| / max(1, |zᵢ(tₖ)|),  maxⱼ |ŷⱼ − yⱼ| )   (docs/accuracy.md (A.1))
+  // over the Birkhoffian variables z = (π1, χ, p1, p2) (absolute below 1 SI unit, relative above) and
+  // the passive coordinates y = (x, y, θ, φ1..φ4, W, I2) (absolute) in SI units, where x̂ − x is
   // the method's own error estimate for the step (the difference to an embedded solution from the
   // same stages, see each integrator's header). Methods without an estimate leave these NaN/0.
   // Filled through record_local_error_estimate(), never written directly.
