@@ -105,7 +105,8 @@ TEST(ToleranceProportionality, EveryShippedSceneEveryControl) {
     scene.duration = std::min(scene.duration, 20.0);
     const CartState reference = reference_end(scene);
     for (const Setting& setting : settings) {
-      if (setting.control == StepControl::kReversible && time_dependent(scene)) continue;  // refused (tested below)
+      // Refused (tested below, and in tolerance_requests_test): loads that vary in time, the paper's case.
+      if (setting.control == StepControl::kReversible && (time_dependent(scene) || scene.paper_special_case)) continue;
       std::vector<double> work;
       double loosest_error = 0.0;
       std::uint64_t loosest_steps = 0;  // internal steps at the loosest tolerance [-]
@@ -118,8 +119,8 @@ TEST(ToleranceProportionality, EveryShippedSceneEveryControl) {
                     static_cast<unsigned long long>(result.statistics.rejected_steps),
                     static_cast<unsigned long long>(result.statistics.internal_steps));
         // The adaptive control's promise is 2× (accuracy.md §4.3: worst measured 1.4×, gauss6 on
-        // stiff_hinge at 1e-7 m); the reversible control's 10× (3.4× measured: gauss8 on paper_special
-        // at 1e-7 m in the autonomous form).
+        // stiff_hinge at 1e-7 m); the reversible control's 10× (0.29× measured, gauss8 on
+        // reverse_jackknife at 1e-5 m: its ε cap sets the steps on these short runs).
         const double promise = setting.control == StepControl::kAdaptive ? kAdaptivePromise : kReversiblePromise;
         EXPECT_LE(error, promise * tolerance + 1e-10) << name << " " << setting.member << " at " << tolerance << " m";
         if (setting.control == StepControl::kAdaptive && setting.member != "dopri5") {

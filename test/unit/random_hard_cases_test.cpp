@@ -71,6 +71,7 @@ std::string cause_of(const std::string& message) {
       {"Newton", "StepError: the implicit solve (Newton) failed"},
       {"non-finite", "StepError: a non-finite value, caught before it reached an output"},
       {"internal steps", "StepError: dopri5's work limit (100 000 internal steps in one simulator step)"},
+      {"paper's special case", "refused when the run is built: the reversible control on the paper's special case"},
       {"fictive step", "StepError: the reversible control's fictive step fell below its floor"},
       {"needs loads that do not vary in time", "refused when the run is built: the reversible control with loads that vary in time"},
       {"out of reach", "refused when the run is built: the reversible control's tolerance out of the member's reach"},
@@ -148,12 +149,14 @@ TEST(RandomHardCases, EveryIntegratorEndsFiniteWithAVerdictOrStopsWithANamedStep
         built = std::make_unique<Simulation>(run);
       } catch (const std::invalid_argument& error) {
         // The reversible control is refused when the simulation is built, by name (CLI exit 3):
-        // for loads that vary in time (its time transformation reads them at one time), and for a
+        // for loads that vary in time (its time transformation reads them at one time), on the
+        // paper's special case (its ε calibrated at the start misses near the pole), and for a
         // start its trial grids cannot integrate.
         ASSERT_TRUE(reversible) << run.name << " with " << integrator << ": " << error.what();
         const std::string message = error.what();
         EXPECT_TRUE(message.find("reversible step control") != std::string::npos ||
-                    message.find("step_control 'reversible' needs loads that do not vary in time") != std::string::npos)
+                    message.find("step_control 'reversible' needs loads that do not vary in time") != std::string::npos ||
+                    message.find("step_control 'reversible' cannot hold the paper's special case") != std::string::npos)
             << message;
         ++tallies[integrator].step_error;
         ++step_error_causes[cause_of(message)];

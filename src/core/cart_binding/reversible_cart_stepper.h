@@ -65,6 +65,15 @@ class ReversibleCartStepperAdapter final
           "step_control 'reversible' needs loads that do not vary in time (its time transformation reads them at "
           "one time): this scene's torque profile or actuator does; use step_control 'adaptive'");
     }
+    // Its ε is calibrated at the run's start; the paper's case stiffens towards its pole at χ = π
+    // (det M → 0), and birkhoff_gauss8 under it ended 3.4× beyond 1e-7 m and 2.6× beyond 1e-9 m
+    // (accuracy.md §4.4): refused rather than missed silently.
+    if (model.inertia_model() == InertiaModel::kPaperSpecialCase) {
+      throw std::invalid_argument(
+          "step_control 'reversible' cannot hold the paper's special case (paper_special_case: true) to its "
+          "tolerance: its fictive step is calibrated at the run's start, and the case stiffens towards its pole at "
+          "chi = pi (birkhoff_gauss8 under it ended 3.4x beyond 1e-7 m); use step_control 'adaptive'");
+    }
   }
 
   bool symmetric() const override { return true; }
