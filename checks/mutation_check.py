@@ -147,7 +147,7 @@ MUTATIONS = [
         "adaptive_accepts_every_step",
         "the error-per-step control accepts a step whatever its estimate says",
         "include/birkhoff_cart/core/integrators/adaptive_step_control.h",
-        "if (!solved || !finite_point() || !(ratio <= 1.0) ||",
+        "if (!solved || !finite_point() || !(ratio <= settings_.acceptance_ratio) ||",
         "if (!solved || !finite_point() || !(ratio <= 1e30) ||",
         [("adaptive_step_control_test", "*")],
     ),

@@ -2,8 +2,8 @@
 // docs/birkhoffian.md §11–§12): a position tolerance drives every Birkhoffian member and dopri5 on
 // every shipped scene, the delivered error lands within 2× of it under the adaptive control and 10× under
 // the reversible one (for the Gauss members under the
-// adaptive control also above 1/30 000 of it, with rejected attempts below a quarter of the accepted
-// steps) and the work falls as it loosens;
+// adaptive control also above 1/100 000 of it, with rejected attempts at most a tenth of the accepted
+// steps but one) and the work falls as it loosens;
 // every accepted step meets its error per unit step, a rejected or failed attempt never reaches the
 // caller, steps land on the loads' kinks, a stiff hinge runs where fixed steps fail, the dense output
 // matches the grid at its points and a tight run between them with the member's order, rows between
@@ -77,11 +77,14 @@ bool time_dependent(const Scene& scene) {
 /// Loose bounds on the Gauss members under the adaptive control (docs/accuracy.md §4.3 has the
 /// measured figures): the delivered error not below tolerance / this [-], and rejected attempts at
 /// most this share of the accepted steps [-].
-constexpr double kOverdeliveryBound = 3e4;
+constexpr double kOverdeliveryBound = 1e5;  // 1.7e-5 measured: gauss4 on very_stiff_hinge at 1e-3 m (20 s)
 /// The delivered error at most this many times the tolerance under each control [-].
 constexpr double kAdaptivePromise = 2.0;
 constexpr double kReversiblePromise = 10.0;
-constexpr double kRejectedShareBound = 0.25;
+constexpr double kRejectedShareBound = 0.10;
+/// One rejection more: a run of fewer than ten steps cannot keep one below a tenth (paper_special,
+/// gauss8: one rejected of 6 steps, where the motion stiffens towards the pole within a step) [-].
+constexpr double kRejectedSlack = 1.0;
 /// A run of at most this many internal steps is at the start's floor of work [-].
 constexpr std::uint64_t kStartFloorSteps = 10;
 
@@ -130,9 +133,10 @@ TEST(ToleranceProportionality, EveryShippedSceneEveryControl) {
           if (name != "driven" && tolerance / kOverdeliveryBound >= 1e-10) {
             EXPECT_GE(error, tolerance / kOverdeliveryBound) << name << " " << setting.member << " at " << tolerance << " m";
           }
-          // The controller does not thrash (a loose bound: a few rejections at the start and the kinks).
+          // The controller does not thrash: rejected attempts at most a tenth of the accepted steps
+          // (issue goal), but for one.
           EXPECT_LE(static_cast<double>(result.statistics.rejected_steps),
-                    kRejectedShareBound * static_cast<double>(result.statistics.internal_steps) + 4.0)
+                    kRejectedShareBound * static_cast<double>(result.statistics.internal_steps) + kRejectedSlack)
               << name << " " << setting.member << " at " << tolerance << " m";
         }
         work.push_back(static_cast<double>(result.statistics.rhs_evaluations));
@@ -160,8 +164,8 @@ TEST(ToleranceProportionality, EveryShippedSceneEveryControl) {
 }
 
 TEST(AdaptiveStepControl, EveryAcceptedStepMeetsItsErrorPerUnitStep) {
-  // The control on drive_rr_drag (forced, dissipative): each accepted step's ê ≤ τh (B.46), some
-  // attempts rejected, and the stage solve stopped short of round-off (fewer iterations than at κ = 0).
+  // The control on drive_rr_drag (forced, dissipative): each accepted step's ê ≤ A·τh (B.46), and
+  // the stage solve stopped short of round-off (fewer iterations than at κ = 0).
   const Scene scene = shipped("drive_rr_drag");
   const CartModel model(scene.cart);
   const EffectSet effects = build_effects(scene.effects, model, scene.actuators, 0.0);
@@ -180,7 +184,8 @@ TEST(AdaptiveStepControl, EveryAcceptedStepMeetsItsErrorPerUnitStep) {
     while (control.time() < scene.duration) {
       const double h = control.step(system, scene.duration, statistics);
       if (check) {
-        EXPECT_LE(statistics.local_error_estimate_last_step, settings.error_per_unit_step * h) << "at t = " << control.time();
+        EXPECT_LE(statistics.local_error_estimate_last_step, settings.acceptance_ratio * settings.error_per_unit_step * h)
+            << "at t = " << control.time();
       }
     }
     EXPECT_EQ(control.time(), scene.duration) << "the last step lands on the limit";
@@ -454,6 +459,26 @@ TEST(AdaptiveStepControl, BadSettingsAreRefusedByName) {
   }
   Simulation fixed(configured(shipped("sine_steer_torque"), "birkhoff_gauss4", StepControl::kFixed, 0.0));
   EXPECT_THROW(fixed.advance_output_to(1.0), std::logic_error) << "a fixed-step run has no output between its steps";
+  // The control's own settings (adaptive_step_control.h), each refused with its name.
+  using Control = AdaptiveStepControl<GaussCollocation<3>, CartAutonomousBirkhoffian,
+                                      CarriedCartState<CartAutonomousBirkhoffian, GaussCollocation<3>::Memory<CartAutonomousBirkhoffian>>>;
+  auto refusal = [](AdaptiveStepSettings settings) -> std::string {
+    try {
+      Control control(GaussCollocation<3>(), settings);
+    } catch (const std::invalid_argument& error) {
+      return error.what();
+    }
+    return "accepted";
+  };
+  AdaptiveStepSettings below_aim;
+  below_aim.acceptance_ratio = 0.5;
+  EXPECT_NE(refusal(below_aim).find("acceptance ratio"), std::string::npos) << refusal(below_aim);
+  AdaptiveStepSettings no_margin;
+  no_margin.start_exponent_margin = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(refusal(no_margin).find("exponent margin"), std::string::npos) << refusal(no_margin);
+  AdaptiveStepSettings no_aim;
+  no_aim.error_per_unit_step = -1.0;
+  EXPECT_NE(refusal(no_aim).find("error per unit step"), std::string::npos) << refusal(no_aim);
 }
 
 }  // namespace

@@ -58,6 +58,8 @@ class AdaptiveCartStepperAdapter final
   /// legitimate run can take more than DOPRI5's NMAX of 100 000: birkhoff_gauss4 on very_stiff_hinge
   /// at 1e-5 m with one output row over its 20 s takes 146 863 steps, at 1e-7 m 553 049.
   static constexpr std::uint64_t kMaxInternalStepsPerOutput = 1000000;
+  /// A of (B.46) [-]: an attempt is kept while ê ≤ A·τ_a·|h|.
+  static constexpr double kAcceptanceRatio = 2.0;
   /// A failed side step is retried in up to 2^kMaxSideStepHalvings substeps.
   static constexpr int kMaxSideStepHalvings = 6;
   /// κ of (B.49) and (B.49') [-]: the grid's is rescaled to the asked τ in control_settings().
@@ -84,6 +86,10 @@ class AdaptiveCartStepperAdapter final
     // The stage solve stops at κ·τ·h of the asked τ (B.49), not of the aim.
     control.stage_change_fraction *= asked / control.error_per_unit_step;
     control.max_steps_per_advance = kMaxInternalStepsPerOutput;
+    // τ_a is an aim calibrated against the delivered position error, not a bound on each step: an
+    // attempt is kept up to twice it (B.46), where ê's swings with the motion's phase would
+    // otherwise reject one step in 6–20 on the short scenes (birkhoffian.md §12.1).
+    control.acceptance_ratio = kAcceptanceRatio;
     return control;
   }
 

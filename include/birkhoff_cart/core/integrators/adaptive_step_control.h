@@ -2,9 +2,13 @@
 // (docs/birkhoffian.md §12, eqs. (B.46)–(B.49)). The member's own local error estimate ê (the
 // collocation defect, eq. (B.37); a composition's sum of its sub-steps') decides each step:
 //
-//   accept when ê ≤ τ·|h|      (error per unit step)                                           (B.46)
+//   accept when ê ≤ A·τ·|h|    (error per unit step)                                           (B.46)
 //   h_new = h · min(α_max, max(α_min, 0.9·(τ|h|/ê)^{1/(q−1)}))   (ê ∝ h^q)                     (B.47)
 //
+// The control steers ê towards 0.9^{q−1}·τ|h|. With A = 1 (the default) every accepted step meets
+// τ|h|, and the estimates add up to at most τ·T; a caller whose τ is an aim rather than a bound (the
+// cart's adapter, A = 2: birkhoffian.md §12.1) keeps an attempt just above it rather than take it
+// again where ê swings with the motion's phase by more than the safety factor's margin.
 // with τ [1/s] the error per second the estimate is aimed at, in ê's units (error_estimate.h, (A.1)):
 // the adapter derives it from the position tolerance by the member's tolerance proportionality (eq. (B.53)); for the Gauss members ê includes the step's
 // weighted linearised error (B.55), which sees a stiff mode a step would jump over. The growth reads the larger of the last two
@@ -47,10 +51,12 @@ namespace birkhoff_cart {
 /// Settings of the error-per-step control.
 struct AdaptiveStepSettings {
   double error_per_unit_step = 1e-9;  ///< τ: allowed ê per second of scene time [1/s] (eq. (B.46))
+  double acceptance_ratio = 1.0;       ///< A: an attempt is kept while ê ≤ A·τ·|h| (eq. (B.46)) [-]
   double stage_change_fraction = 0.01;  ///< κ: the stage solve stops at κ·τ·|h| (eq. (B.49)) [-]
   double safety = 0.9;                 ///< factor on the predicted step [-]
   double max_growth = 4.0;             ///< α_max: largest growth of h from one step to the next [-]
   double start_growth = 100.0;         ///< α_max while the steps after a start still grow unhindered [-]
+  double start_exponent_margin = 1.0;  ///< added to q − 1 in (B.47) while they do [-]
   double keep_ratio = 1.2;             ///< a step that would grow by less is kept (its Newton matrix reused) [-]
   double max_shrink = 0.2;             ///< α_min: smallest factor after a rejection [-]
   double ceiling_growth = 1.02;        ///< growth a step after a rejection while ê reads 0 [-]
@@ -75,6 +81,12 @@ class AdaptiveStepControl {
       : stepper_(stepper), settings_(settings) {
     if (!(settings.error_per_unit_step > 0.0) || !std::isfinite(settings.error_per_unit_step)) {
       throw std::invalid_argument("adaptive step control: the error per unit step must be finite and > 0 1/s");
+    }
+    if (!(settings.acceptance_ratio >= 1.0) || !std::isfinite(settings.acceptance_ratio)) {
+      throw std::invalid_argument("adaptive step control: the acceptance ratio must be finite and >= 1");
+    }
+    if (!(settings.start_exponent_margin >= 0.0) || !std::isfinite(settings.start_exponent_margin)) {
+      throw std::invalid_argument("adaptive step control: the start's exponent margin must be finite and >= 0");
     }
     if (!(settings.stage_change_fraction >= 0.0) || !std::isfinite(settings.stage_change_fraction)) {
       throw std::invalid_argument("adaptive step control: the stage change fraction must be finite and >= 0");
@@ -157,9 +169,9 @@ class AdaptiveStepControl {
       const double allowed = settings_.error_per_unit_step * h;      // τ·h [-]
       // ê below its round-off floor says only "no error seen": at tiny steps it would otherwise
       // read as an error per unit step that grows as h shrinks, and hold the steps there.
-      const double ratio = std::max(estimate - kEstimateRoundOff, 0.0) / allowed;  // ≤ 1: accept (B.46)
+      const double ratio = std::max(estimate - kEstimateRoundOff, 0.0) / allowed;  // ≤ A: accept (B.46)
       add_work(statistics, trial);
-      if (!solved || !finite_point() || !(ratio <= 1.0) || !plausible(saved_point, grid_.point, time(), h)) {
+      if (!solved || !finite_point() || !(ratio <= settings_.acceptance_ratio) || !plausible(saved_point, grid_.point, time(), h)) {
         grid_.point = saved_point;
         grid_.memory.restore(saved_history);
         ++statistics.rejected_steps;
@@ -248,9 +260,14 @@ class AdaptiveStepControl {
   }
   /// After a start the first guess may be far too small: the steps then grow by up to
   /// start_growth until the first rejection or the first step the control would not grow freely.
+  /// While they do, the growth reads ê/h ∝ h^{q−1+m} (m = start_exponent_margin): a growth of 10–40×
+  /// reaches steps where ê has left its asymptotic range and grows faster than h^{q−1} (the shipped
+  /// scenes' start ramps: up to q − 1 + 1.9 between two readings), and the step after the ramp was
+  /// rejected at 20–600 times its aim.
   double growth_factor(double ratio) {
     const double cap = ramping_ ? settings_.start_growth : settings_.max_growth;
-    const double wanted = ratio > 0.0 ? settings_.safety * deterministic::pow(ratio, -1.0 / kExponentOrder)
+    const double exponent = kExponentOrder + (ramping_ ? settings_.start_exponent_margin : 0.0);
+    const double wanted = ratio > 0.0 ? settings_.safety * deterministic::pow(ratio, -1.0 / exponent)
                                       : std::numeric_limits<double>::infinity();  // ê = 0: grow at once
     if (wanted < settings_.max_growth) ramping_ = false;
     return std::min(cap, std::max(settings_.max_shrink, wanted));
