@@ -5,10 +5,6 @@
 //   accept when ê ≤ A·τ·|h|    (error per unit step)                                           (B.46)
 //   h_new = h · min(α_max, max(α_min, 0.9·(τ|h|/ê)^{1/(q−1)}))   (ê ∝ h^q)                     (B.47)
 //
-// The control steers ê towards 0.9^{q−1}·τ|h|. With A = 1 (the default) every accepted step meets
-// τ|h|, and the estimates add up to at most τ·T; a caller whose τ is an aim rather than a bound (the
-// cart's adapter, A = 2: birkhoffian.md §12.1) keeps an attempt just above it rather than take it
-// again where ê swings with the motion's phase by more than the safety factor's margin.
 // with τ [1/s] the error per second the estimate is aimed at, in ê's units (error_estimate.h, (A.1)):
 // the adapter derives it from the position tolerance by the member's tolerance proportionality (eq. (B.53)); for the Gauss members ê includes the step's
 // weighted linearised error (B.55), which sees a stiff mode a step would jump over. The growth reads the larger of the last two
@@ -20,6 +16,11 @@
 // eq. (B.49)), not at round-off. A step never passes the limit it is given: the run's end, a
 // landing instant, a kink of the loads (the caller passes them); it is stretched by up to 10 % to
 // land on it rather than leave a sliver.
+//
+// The control steers ê towards 0.9^{q−1}·τ|h|. With A = 1 (the default) every accepted step meets
+// τ|h|, and the estimates add up to at most τ·T; a caller whose τ is an aim rather than a bound (the
+// cart's adapter, A = 2: birkhoffian.md §12.1) keeps an attempt just above it rather than take it
+// again where ê swings with the motion's phase by more than the safety factor's margin.
 //
 // It knows no system beyond the concept (birkhoffian_system.h) and its optional traits
 // (system_traits.h): the system's begin_step(t) before each attempt, its angles carried reduced in
