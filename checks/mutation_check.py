@@ -288,7 +288,7 @@ MUTATIONS = [
         "include/birkhoff_cart/core/integrators/collocation_error_estimate.h",
         "    if (memory.linear_mode_error) {",
         "    if (false) {",
-        [("adaptive_step_control_test", "*SteppedOver*")],
+        [("adaptive_step_control_test", "*SteppedOver*"), ("system_step_controls_test", "*Linearised*")],
     ),
     Mutation(
         "passive_coordinates_measured_relatively",
