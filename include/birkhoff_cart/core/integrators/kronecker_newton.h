@@ -26,6 +26,9 @@
 #include <cmath>
 #include <type_traits>
 #include <utility>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 
 namespace birkhoff_cart {
@@ -64,6 +67,12 @@ class KroneckerNewtonInverse {
   template <class S>
   void apply(const std::array<S, n * s>& residual, std::array<S, n * s>& correction) const {
     with_block_size(m_, [&](auto block) {
+#if defined(__SSE2__)
+      if constexpr (std::is_same<S, double>::value && s % 2 == 0) {
+        apply_block_by_stages<decltype(block)::value>(residual, correction);
+        return true;
+      }
+#endif
       apply_block<decltype(block)::value>(residual, correction);
       return true;
     });
@@ -76,9 +85,10 @@ class KroneckerNewtonInverse {
   using Small = std::array<std::array<double, n>, n>;
   using Square = std::array<std::array<double, s>, s>;
 
-  /// product = left · right on the leading size × size entries.
-  template <class Matrix>
-  static void multiply(const Matrix& left, const Matrix& right, Matrix& product, int size) {
+  /// product = left · right on the leading size × size entries (size a constant, so that the loops
+  /// unroll: with a run-time bound they were the largest part of the build).
+  template <int size, class Matrix>
+  static void multiply(const Matrix& left, const Matrix& right, Matrix& product) {
     for (int i = 0; i < size; ++i) {
       for (int j = 0; j < size; ++j) {
         double sum = 0.0;
@@ -95,17 +105,19 @@ class KroneckerNewtonInverse {
     for (int a = 0; a < m; ++a) {
       for (int b = 0; b < m; ++b) j_aa[a][b] = jacobian(active_[a], active_[b]);
     }
-    for (int p = 0; p < n; ++p) j_power_[p] = Small{};
-    for (int a = 0; a < m; ++a) j_power_[0][a][a] = 1.0;
-    for (int p = 1; p < m; ++p) multiply(j_aa, j_power_[p - 1], j_power_[p], m);
+    // Only the leading m × m entries of the first m powers are written and read (apply, all_finite).
+    for (int a = 0; a < m; ++a) {
+      for (int b = 0; b < m; ++b) j_power_[0][a][b] = a == b ? 1.0 : 0.0;
+    }
+    for (int p = 1; p < m; ++p) multiply<m>(j_aa, j_power_[p - 1], j_power_[p]);
     // e_k: det(xI − J) = Σ_k (−1)^k e_k x^{m−k} = Σ_k c_{m−k} x^{m−k}, e_k = (−1)^k c_{m−k}.
     // Faddeev–LeVerrier: B₁ = I, c_{m−k} = −tr(J B_k)/k, B_{k+1} = J B_k + c_{m−k} I.
     std::array<double, n + 1> e{};
     e[0] = 1.0;
     Small b_k = j_power_[0];
     for (int k = 1; k <= m; ++k) {
-      Small jb{};
-      multiply(j_aa, b_k, jb, m);
+      Small jb;
+      multiply<m>(j_aa, b_k, jb);
       double trace = 0.0;
       for (int a = 0; a < m; ++a) trace += jb[a][a];
       const double c = -trace / k;
@@ -114,12 +126,14 @@ class KroneckerNewtonInverse {
       b_k = jb;
     }
     // y_j = X^j D(X)⁻¹, j ≤ m: f_p = Σ_{p≤j<m} (−1)^{j−p} e_{j−p} y_j and X f_p the same on y_{j+1}.
-    std::array<Square, n + 1> x_power{};
+    std::array<Square, m + 1> x_power;  // X^k, k ≤ m, each written whole below
     for (int i = 0; i < s; ++i) {
-      x_power[0][i][i] = 1.0;
-      for (int j = 0; j < s; ++j) x_power[1][i][j] = h * coefficients[i][j];
+      for (int j = 0; j < s; ++j) {
+        x_power[0][i][j] = i == j ? 1.0 : 0.0;
+        x_power[1][i][j] = h * coefficients[i][j];
+      }
     }
-    for (int k = 2; k <= m; ++k) multiply(x_power[1], x_power[k - 1], x_power[k], s);
+    for (int k = 2; k <= m; ++k) multiply<s>(x_power[1], x_power[k - 1], x_power[k]);
     Eigen::Matrix<double, s, s> denominator = Eigen::Matrix<double, s, s>::Zero();  // D(X)
     for (int k = 0; k <= m; ++k) {
       const double coefficient = (k % 2 == 0) ? e[k] : -e[k];
@@ -130,8 +144,12 @@ class KroneckerNewtonInverse {
     // Eigen's closed-form inverse for s ≤ 4; a singular D gives non-finite entries (checked below).
     const Eigen::Matrix<double, s, s> denominator_inverse = denominator.inverse();
     if (!denominator_inverse.allFinite()) return false;
-    std::array<Square, n + 1> y{};
-    for (int k = 0; k <= m; ++k) {
+    std::array<Square, m + 1> y;  // written whole below
+    // y_0 = D(X)⁻¹ (+ 0.0: a −0 entry reads +0, as the product with I it stands for would give).
+    for (int i = 0; i < s; ++i) {
+      for (int j = 0; j < s; ++j) y[0][i][j] = denominator_inverse(i, j) + 0.0;
+    }
+    for (int k = 1; k <= m; ++k) {
       for (int i = 0; i < s; ++i) {
         for (int j = 0; j < s; ++j) {
           double sum = 0.0;
@@ -140,16 +158,19 @@ class KroneckerNewtonInverse {
         }
       }
     }
+    std::array<double, m> signed_e;  // (−1)^k e_k
+    for (int k = 0; k < m; ++k) signed_e[k] = (k % 2 == 0) ? e[k] : -e[k];
     for (int p = 0; p < m; ++p) {
-      f_[p] = Square{};
-      x_f_[p] = Square{};
-      for (int j = p; j < m; ++j) {
-        const double coefficient = ((j - p) % 2 == 0) ? e[j - p] : -e[j - p];
-        for (int r = 0; r < s; ++r) {
-          for (int q = 0; q < s; ++q) {
-            f_[p][r][q] += coefficient * y[j][r][q];
-            x_f_[p][r][q] += coefficient * y[j + 1][r][q];
+      for (int r = 0; r < s; ++r) {
+        for (int q = 0; q < s; ++q) {
+          double f = 0.0;
+          double x_f = 0.0;
+          for (int j = p; j < m; ++j) {
+            f += signed_e[j - p] * y[j][r][q];
+            x_f += signed_e[j - p] * y[j + 1][r][q];
           }
+          f_[p][q][r] = f;  // transposed: column q of f_p(X) is f_[p][q]
+          x_f_[p][q][r] = x_f;
         }
       }
     }
@@ -163,7 +184,7 @@ class KroneckerNewtonInverse {
         }
       }
     }
-    return all_finite();
+    return all_finite<m>();
   }
 
   template <int m, class S>
@@ -175,7 +196,7 @@ class KroneckerNewtonInverse {
       for (int a = 0; a < m; ++a) {
         for (int i = 0; i < s; ++i) {
           S sum = zero;
-          for (int j = 0; j < s; ++j) sum += f_[p][i][j] * residual[j * n + active_[a]];
+          for (int j = 0; j < s; ++j) sum += f_[p][j][i] * residual[j * n + active_[a]];
           h_p[p][a][i] = sum;
         }
       }
@@ -203,12 +224,89 @@ class KroneckerNewtonInverse {
       for (int i = 0; i < s; ++i) {
         S sum = residual[i * n + cyclic_[c]];
         for (int p = 0; p < m; ++p) {
-          for (int j = 0; j < s; ++j) sum += x_f_[p][i][j] * q[p][j];
+          for (int j = 0; j < s; ++j) sum += x_f_[p][j][i] * q[p][j];
         }
         correction[i * n + cyclic_[c]] = sum;
       }
     }
   }
+
+#if defined(__SSE2__)
+  /// s doubles, one per stage, in s/2 SSE2 registers (baseline x86-64): one operation computes an
+  /// entry for two stages. Only multiplications and additions, each rounded once as the scalar code
+  /// rounds it (no fused multiply-add): the same bits on every x86-64 CPU.
+  struct StageLanes {
+    __m128d pair[s / 2];
+    static StageLanes load(const double* values) {
+      StageLanes lanes;
+      for (int k = 0; k < s / 2; ++k) lanes.pair[k] = _mm_loadu_pd(values + 2 * k);
+      return lanes;
+    }
+    static StageLanes filled(double value) {
+      StageLanes lanes;
+      for (int k = 0; k < s / 2; ++k) lanes.pair[k] = _mm_set1_pd(value);
+      return lanes;
+    }
+    void store(double* values) const {
+      for (int k = 0; k < s / 2; ++k) _mm_storeu_pd(values + 2 * k, pair[k]);
+    }
+    /// this += factor · lanes, lane by lane (the product first, as `sum += a * b`).
+    void add_product(const StageLanes& lanes, double factor) {
+      const __m128d broadcast = _mm_set1_pd(factor);
+      for (int k = 0; k < s / 2; ++k) pair[k] = _mm_add_pd(pair[k], _mm_mul_pd(lanes.pair[k], broadcast));
+    }
+  };
+
+  /// apply_block() for doubles with the stages in the lanes of SSE2 registers: every entry adds its
+  /// terms in the order apply_block() does (the same sums, the same bits), two stages per
+  /// instruction. For gauss8 (s = 4) the scalar apply was 24 % of a fixed-step run on
+  /// sine_steer_torque, ~800 instructions for its ~300 multiply-adds (bench/price_callgrind.py); the
+  /// compiler did not vectorise its loops, nor the same loops written with the stages innermost.
+  template <int m>
+  void apply_block_by_stages(const std::array<double, n * s>& residual, std::array<double, n * s>& correction) const {
+    const double zero = 0.0 * residual[0];  // apply_block()'s start of every sum (−0 where it is)
+    double g[m][s];                          // G_j(a), the block's rows of the residual
+    for (int a = 0; a < m; ++a) {
+      for (int j = 0; j < s; ++j) g[a][j] = residual[j * n + active_[a]];
+    }
+    // H_p(a, ·) = Σ_j f_p(·, j) G_j(a)
+    StageLanes h_p[m][m];
+    for (int p = 0; p < m; ++p) {
+      StageLanes columns[s];
+      for (int j = 0; j < s; ++j) columns[j] = StageLanes::load(f_[p][j].data());
+      for (int a = 0; a < m; ++a) {
+        StageLanes sum = StageLanes::filled(zero);
+        for (int j = 0; j < s; ++j) sum.add_product(columns[j], g[a][j]);
+        h_p[p][a] = sum;
+      }
+    }
+    // ΔZ_·(a) = Σ_p Σ_b (J^p)(a, b) H_p(b, ·)
+    for (int a = 0; a < m; ++a) {
+      StageLanes sum = h_p[0][a];
+      for (int p = 1; p < m; ++p) {
+        for (int b = 0; b < m; ++b) sum.add_product(h_p[p][b], j_power_[p][a][b]);
+      }
+      double stages[s];
+      sum.store(stages);
+      for (int i = 0; i < s; ++i) correction[i * n + active_[a]] = stages[i];
+    }
+    // ΔZ_·(c) = G_·(c) + Σ_p Σ_j (X f_p)(·, j) (J_ca J^p · G_j)
+    for (int c = 0; c < cyclic_count_; ++c) {
+      double stages[s];
+      for (int i = 0; i < s; ++i) stages[i] = residual[i * n + cyclic_[c]];
+      StageLanes sum = StageLanes::load(stages);
+      for (int p = 0; p < m; ++p) {
+        StageLanes q = StageLanes::filled(zero);  // lane j: J_ca J^p · G_j
+        for (int a = 0; a < m; ++a) q.add_product(StageLanes::load(g[a]), row_power_[c][p][a]);
+        double q_j[s];
+        q.store(q_j);
+        for (int j = 0; j < s; ++j) sum.add_product(StageLanes::load(x_f_[p][j].data()), q_j[j]);
+      }
+      sum.store(stages);
+      for (int i = 0; i < s; ++i) correction[i * n + cyclic_[c]] = stages[i];
+    }
+  }
+#endif
 
   /// f(std::integral_constant<int, size>) for the block size in use, so that the loops over the
   /// block have constant bounds; false when no block size ≤ m matches (none: m_ ≥ 1 always).
@@ -222,20 +320,20 @@ class KroneckerNewtonInverse {
     }
   }
 
+  /// Every factor finite (one product per factor: a non-finite entry makes it NaN, and the loop has
+  /// no early exit to branch on).
+  template <int m>
   bool all_finite() const {
-    for (int p = 0; p < m_; ++p) {
+    double product = 0.0;
+    for (int p = 0; p < m; ++p) {
       for (int i = 0; i < s; ++i) {
-        for (int j = 0; j < s; ++j) {
-          if (!std::isfinite(f_[p][i][j]) || !std::isfinite(x_f_[p][i][j])) return false;
-        }
+        for (int j = 0; j < s; ++j) product += 0.0 * f_[p][i][j] + 0.0 * x_f_[p][i][j];
       }
-      for (int a = 0; a < m_; ++a) {
-        for (int b = 0; b < m_; ++b) {
-          if (!std::isfinite(j_power_[p][a][b])) return false;
-        }
+      for (int a = 0; a < m; ++a) {
+        for (int b = 0; b < m; ++b) product += 0.0 * j_power_[p][a][b];
       }
     }
-    return true;
+    return product == 0.0;
   }
 
   // The factors are left uninitialised until build() writes them: nothing reads beyond m_ and
@@ -246,8 +344,8 @@ class KroneckerNewtonInverse {
   int cyclic_count_ = 0;                      ///< cyclic coordinates taken out of it
   std::array<int, n> active_{};               ///< the block's coordinates
   std::array<int, n> cyclic_{};               ///< the cyclic ones
-  std::array<Square, n> f_;                   ///< f_p(X), p < m
-  std::array<Square, n> x_f_;                 ///< X f_p(X)
+  std::array<Square, n> f_;                   ///< f_p(X), p < m, by columns: f_[p][j][i] = f_p(X)(i, j)
+  std::array<Square, n> x_f_;                 ///< X f_p(X), by columns as f_
   std::array<Small, n> j_power_;              ///< J^p on the block, p < m
   std::array<std::array<std::array<double, n>, n>, n> row_power_;  ///< [cyclic][p]: J_ca J^p, p < m
 };
