@@ -26,9 +26,13 @@
 #include <cmath>
 #include <type_traits>
 #include <utility>
-#if defined(__SSE2__)
+#if defined(__x86_64__)
+#include <immintrin.h>
+#elif defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+
+#include "birkhoff_cart/core/integrators/vector_math.h"
 
 
 namespace birkhoff_cart {
@@ -67,6 +71,14 @@ class KroneckerNewtonInverse {
   template <class S>
   void apply(const std::array<S, n * s>& residual, std::array<S, n * s>& correction) const {
     with_block_size(m_, [&](auto block) {
+#if defined(__x86_64__)
+      if constexpr (std::is_same<S, double>::value && s == 4) {
+        if (stage_evaluation() == StageEvaluation::kVector) {  // the CPU has AVX (vector_math.h)
+          apply_block_avx<decltype(block)::value>(residual, correction);
+          return true;
+        }
+      }
+#endif
 #if defined(__SSE2__)
       if constexpr (std::is_same<S, double>::value && s % 2 == 0) {
         apply_block_by_stages<decltype(block)::value>(residual, correction);
@@ -303,6 +315,61 @@ class KroneckerNewtonInverse {
         for (int j = 0; j < s; ++j) sum.add_product(StageLanes::load(x_f_[p][j].data()), q_j[j]);
       }
       sum.store(stages);
+      for (int i = 0; i < s; ++i) correction[i * n + cyclic_[c]] = stages[i];
+    }
+  }
+#endif
+
+#if defined(__x86_64__)
+  /// apply_block_by_stages() for four stages in one AVX register (the vector stage evaluation of
+  /// vector_math.h: chosen at run time where the CPU has AVX). The same multiplications and additions
+  /// in the same order, without fused multiply-add, so the bits are the scalar loops' again; the
+  /// three-operand AVX forms also spare the register copies that SSE2's two-operand forms need
+  /// (gauss8 on the cart: about 380 instructions an apply against the pairs' 750; birkhoffian.md
+  /// §10.6).
+  template <int m>
+  __attribute__((target("avx"))) void apply_block_avx(const std::array<double, n * s>& residual,
+                                                      std::array<double, n * s>& correction) const {
+    static_assert(s == 4, "one AVX register holds the four stages");
+    const __m256d zeros = _mm256_set1_pd(0.0 * residual[0]);  // apply_block()'s start of every sum
+    double g[m][s];                                          // G_j(a), the block's rows of the residual
+    for (int a = 0; a < m; ++a) {
+      for (int j = 0; j < s; ++j) g[a][j] = residual[j * n + active_[a]];
+    }
+    // H_p(a, ·) = Σ_j f_p(·, j) G_j(a)
+    __m256d h_p[m][m];
+    for (int p = 0; p < m; ++p) {
+      __m256d columns[s];
+      for (int j = 0; j < s; ++j) columns[j] = _mm256_loadu_pd(f_[p][j].data());
+      for (int a = 0; a < m; ++a) {
+        __m256d sum = zeros;
+        for (int j = 0; j < s; ++j) sum = _mm256_add_pd(sum, _mm256_mul_pd(columns[j], _mm256_set1_pd(g[a][j])));
+        h_p[p][a] = sum;
+      }
+    }
+    // ΔZ_·(a) = Σ_p Σ_b (J^p)(a, b) H_p(b, ·)
+    for (int a = 0; a < m; ++a) {
+      __m256d sum = h_p[0][a];
+      for (int p = 1; p < m; ++p) {
+        for (int b = 0; b < m; ++b) sum = _mm256_add_pd(sum, _mm256_mul_pd(h_p[p][b], _mm256_set1_pd(j_power_[p][a][b])));
+      }
+      double stages[s];
+      _mm256_storeu_pd(stages, sum);
+      for (int i = 0; i < s; ++i) correction[i * n + active_[a]] = stages[i];
+    }
+    // ΔZ_·(c) = G_·(c) + Σ_p Σ_j (X f_p)(·, j) (J_ca J^p · G_j)
+    for (int c = 0; c < cyclic_count_; ++c) {
+      double stages[s];
+      for (int i = 0; i < s; ++i) stages[i] = residual[i * n + cyclic_[c]];
+      __m256d sum = _mm256_loadu_pd(stages);
+      for (int p = 0; p < m; ++p) {
+        __m256d q = zeros;  // lane j: J_ca J^p · G_j
+        for (int a = 0; a < m; ++a) q = _mm256_add_pd(q, _mm256_mul_pd(_mm256_loadu_pd(g[a]), _mm256_set1_pd(row_power_[c][p][a])));
+        double q_j[s];
+        _mm256_storeu_pd(q_j, q);
+        for (int j = 0; j < s; ++j) sum = _mm256_add_pd(sum, _mm256_mul_pd(_mm256_loadu_pd(x_f_[p][j].data()), _mm256_set1_pd(q_j[j])));
+      }
+      _mm256_storeu_pd(stages, sum);
       for (int i = 0; i < s; ++i) correction[i * n + cyclic_[c]] = stages[i];
     }
   }
