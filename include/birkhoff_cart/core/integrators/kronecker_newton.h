@@ -243,6 +243,14 @@ class KroneckerNewtonInverse {
     }
   }
 
+  /// g[a][j] = G_j(a), the block's rows of the residual stage by stage (the lanes paths' input).
+  template <int m>
+  void block_rows(const std::array<double, n * s>& residual, double (&g)[m][s]) const {
+    for (int a = 0; a < m; ++a) {
+      for (int j = 0; j < s; ++j) g[a][j] = residual[j * n + active_[a]];
+    }
+  }
+
 #if defined(__SSE2__)
   /// s doubles, one per stage, in s/2 SSE2 registers (baseline x86-64): one operation computes an
   /// entry for two stages. Only multiplications and additions, each rounded once as the scalar code
@@ -277,10 +285,8 @@ class KroneckerNewtonInverse {
   template <int m>
   void apply_block_by_stages(const std::array<double, n * s>& residual, std::array<double, n * s>& correction) const {
     const double zero = 0.0 * residual[0];  // apply_block()'s start of every sum (−0 where it is)
-    double g[m][s];                          // G_j(a), the block's rows of the residual
-    for (int a = 0; a < m; ++a) {
-      for (int j = 0; j < s; ++j) g[a][j] = residual[j * n + active_[a]];
-    }
+    double g[m][s];
+    block_rows<m>(residual, g);
     // H_p(a, ·) = Σ_j f_p(·, j) G_j(a)
     StageLanes h_p[m][m];
     for (int p = 0; p < m; ++p) {
@@ -332,10 +338,8 @@ class KroneckerNewtonInverse {
                                                       std::array<double, n * s>& correction) const {
     static_assert(s == 4, "one AVX register holds the four stages");
     const __m256d zeros = _mm256_set1_pd(0.0 * residual[0]);  // apply_block()'s start of every sum
-    double g[m][s];                                          // G_j(a), the block's rows of the residual
-    for (int a = 0; a < m; ++a) {
-      for (int j = 0; j < s; ++j) g[a][j] = residual[j * n + active_[a]];
-    }
+    double g[m][s];
+    block_rows<m>(residual, g);
     // H_p(a, ·) = Σ_j f_p(·, j) G_j(a)
     __m256d h_p[m][m];
     for (int p = 0; p < m; ++p) {
