@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -128,6 +129,31 @@ TEST_F(StageEvaluationTest, TanhLanesGiveTheDeterministicTanhsBitsOnBothPaths) {
   std::printf("[ compared ] tanh_lanes vector path vs deterministic::tanh, %d batches of 1-4: %ld differ\n",
               kBatches, vector_differing);
   EXPECT_EQ(vector_differing, 0);
+}
+
+// The step controls take a step's two powers from one call (adaptive_step_control.h): each lane
+// must be deterministic::pow's bits, over the ranges a control asks (error ratios from round-off to
+// far beyond the aim, exponents ±1/k) and beyond, with exact zeros, ones and a NaN among them.
+TEST_F(StageEvaluationTest, PowPairGivesTheDeterministicPowsBits) {
+  std::mt19937 random(17);
+  std::uniform_real_distribution<double> log_base(-40.0, 12.0);
+  std::uniform_real_distribution<double> exponent(-2.0, 2.0);
+  long differing = 0;
+  constexpr int kPairs = 200000;
+  for (int trial = 0; trial < kPairs; ++trial) {
+    std::array<double, 2> x{std::exp(log_base(random)), std::exp(log_base(random))};
+    std::array<double, 2> power{exponent(random), 1.0 / (1 + trial % 9)};
+    if (trial % 7 == 0) x[0] = 0.0;
+    if (trial % 11 == 0) x[1] = 1.0;
+    if (trial % 13 == 0) power[0] = -power[0];
+    if (trial == 5) x[1] = std::nan("");
+    const std::array<double, 2> pair = deterministic::pow_pair(x, power);
+    for (int lane = 0; lane < 2; ++lane) {
+      if (!same_bits(pair[lane], deterministic::pow(x[lane], power[lane]))) ++differing;
+    }
+  }
+  std::printf("[ compared ] pow_pair vs deterministic::pow, %d pairs: %ld lanes differ\n", kPairs, differing);
+  EXPECT_EQ(differing, 0);
 }
 
 TEST_F(StageEvaluationTest, StageRatesOnTheScalarPathAreThePointwiseRates) {

@@ -31,6 +31,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -201,12 +202,20 @@ class AdaptiveStepControl {
       // Growth from the larger of this step's and the last step's ratio: where ê swings with the phase
       // of a fast oscillation (the stiff hinge's 400 rad/s), one low reading does not invite a step
       // the next phase rejects.
-      double factor = growth_factor(std::max(ratio, lands ? 0.0 : last_error_ratio_));
+      const double growth_ratio = std::max(ratio, lands ? 0.0 : last_error_ratio_);
       // Gustafsson's predictive term (as RADAU5): where ê/h grows from step to step, shrink ahead
       // of the rejection that would follow: h/h₋ · (r₋/r)^{1/k} · r^{-1/k}.
-      if (last_error_ratio_ > 0.0 && ratio > 0.0 && last_step_ > 0.0 && !lands) {
-        const double predictive = settings_.safety * (h / last_step_) *
-                                  deterministic::pow(last_error_ratio_ / (ratio * ratio), 1.0 / kExponentOrder);
+      const bool predicts = last_error_ratio_ > 0.0 && ratio > 0.0 && last_step_ > 0.0 && !lands;
+      // Both powers from one call (pow_pair: the bits of two pow calls, at about the price of one).
+      std::array<double, 2> powers{0.0, 0.0};
+      if (growth_ratio > 0.0 || predicts) {
+        powers = deterministic::pow_pair({growth_ratio > 0.0 ? growth_ratio : 1.0,
+                                          predicts ? last_error_ratio_ / (ratio * ratio) : 1.0},
+                                         {-1.0 / growth_exponent(), 1.0 / kExponentOrder});
+      }
+      double factor = growth_factor(growth_ratio, powers[0]);
+      if (predicts) {
+        const double predictive = settings_.safety * (h / last_step_) * powers[1];
         factor = std::min(factor, std::max(settings_.max_shrink, predictive));
       }
       // After a rejection (Hairer–Nørsett–Wanner I §II.4): the accepted retry does not grow; and while
@@ -259,16 +268,20 @@ class AdaptiveStepControl {
   double shrink_factor(double ratio) const {
     return std::max(settings_.max_shrink, settings_.safety * deterministic::pow(ratio, -1.0 / kExponentOrder));
   }
+  /// The exponent the growth reads ê/h with: q − 1, plus the margin while the start ramps [-].
+  double growth_exponent() const {
+    return kExponentOrder + (ramping_ ? settings_.start_exponent_margin : 0.0);
+  }
   /// After a start the first guess may be far too small: the steps then grow by up to
   /// start_growth until the first rejection or the first step the control would not grow freely.
   /// While they do, the growth reads ê/h ∝ h^{q−1+m} (m = start_exponent_margin): a growth of 10–40×
   /// reaches steps where ê has left its asymptotic range and grows faster than h^{q−1} (the shipped
   /// scenes' start ramps: up to q − 1 + 1.9 between two readings), and the step after the ramp was
   /// rejected at 20–600 times its aim.
-  double growth_factor(double ratio) {
+  /// `power` = ratio^{−1/growth_exponent()}, computed by the caller (with the predictive term's).
+  double growth_factor(double ratio, double power) {
     const double cap = ramping_ ? settings_.start_growth : settings_.max_growth;
-    const double exponent = kExponentOrder + (ramping_ ? settings_.start_exponent_margin : 0.0);
-    const double wanted = ratio > 0.0 ? settings_.safety * deterministic::pow(ratio, -1.0 / exponent)
+    const double wanted = ratio > 0.0 ? settings_.safety * power
                                       : std::numeric_limits<double>::infinity();  // ê = 0: grow at once
     if (wanted < settings_.max_growth) ramping_ = false;
     return std::min(cap, std::max(settings_.max_shrink, wanted));
